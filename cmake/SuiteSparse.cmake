@@ -1,0 +1,13 @@
+# SuiteSparse 5.12 (Debian 12) ships no CMake config: find KLU and CHOLMOD by hand (spec/stack.md §2.1).
+if(NOT TARGET SuiteSparse::KLU)
+  find_path(SUITESPARSE_INCLUDE_DIR klu.h PATH_SUFFIXES suitesparse REQUIRED)
+  find_library(KLU_LIBRARY klu REQUIRED)
+  find_library(CHOLMOD_LIBRARY cholmod REQUIRED)
+  find_library(SUITESPARSECONFIG_LIBRARY suitesparseconfig REQUIRED)
+  add_library(SuiteSparse::KLU INTERFACE IMPORTED)
+  target_include_directories(SuiteSparse::KLU INTERFACE ${SUITESPARSE_INCLUDE_DIR})
+  target_link_libraries(SuiteSparse::KLU INTERFACE ${KLU_LIBRARY} ${SUITESPARSECONFIG_LIBRARY})
+  add_library(SuiteSparse::CHOLMOD INTERFACE IMPORTED)
+  target_include_directories(SuiteSparse::CHOLMOD INTERFACE ${SUITESPARSE_INCLUDE_DIR})
+  target_link_libraries(SuiteSparse::CHOLMOD INTERFACE ${CHOLMOD_LIBRARY} ${SUITESPARSECONFIG_LIBRARY})
+endif()
