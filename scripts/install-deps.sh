@@ -1,0 +1,40 @@
+#!/usr/bin/env bash
+# Installs shelldyn's build and test dependencies from Debian 12's packages (run as root).
+# Idempotent: does nothing (not even `apt-get update`) when every package is already installed.
+set -euo pipefail
+
+PACKAGES=(
+  cmake g++ make                       # toolchain
+  libsundials-dev                      # SUNDIALS 6.4.1: KINSOL, IDA, ARKODE (+ KLU linear solver)
+  libsuitesparse-dev                   # KLU, CHOLMOD
+  libopenblas0-pthread                 # fast BLAS for CHOLMOD's supernodal factorization
+  libeigen3-dev                        # Eigen 3.4
+  libyaml-cpp-dev libcli11-dev         # case files, command line
+  libgtest-dev libgmock-dev            # unit tests
+  libbenchmark-dev                     # performance programs
+  python3 python3-meshio               # VTU round-trip check in the test suite
+)
+
+missing=()
+for p in "${PACKAGES[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ ${#missing[@]} -eq 0 ]; then
+  echo "install-deps: all ${#PACKAGES[@]} packages present"
+  exit 0
+fi
+SUDO=""
+if [ "$(id -u)" -ne 0 ]; then
+  if command -v sudo >/dev/null 2>&1; then
+    SUDO="sudo"
+  else
+    echo "install-deps: missing packages: ${missing[*]}" >&2
+    echo "install-deps: run this script as root to install them" >&2
+    exit 1
+  fi
+fi
+echo "install-deps: installing ${missing[*]}"
+export DEBIAN_FRONTEND=noninteractive
+$SUDO env DEBIAN_FRONTEND=noninteractive apt-get update -qq
+$SUDO env DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+echo "install-deps: done"
