@@ -1,0 +1,203 @@
+// Co-rotational triad, T and K_σ: spec/element.md §3.1-3.4.
+#include "elements/corotational_frame.hpp"
+
+#include <Eigen/Geometry>
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+
+namespace shelldyn {
+
+namespace {
+
+using Mat312 = Eigen::Matrix<double, 3, 12>;
+
+Eigen::Matrix3d skew(const Eigen::Vector3d& v) {
+  Eigen::Matrix3d S;
+  S << 0, -v(2), v(1), v(2), 0, -v(0), -v(1), v(0), 0;
+  return S;
+}
+
+// P(v) = (I - v̂ v̂^T)/|v|: Jacobian of v -> v̂ (§3.3).
+Eigen::Matrix3d unit_jacobian(const Eigen::Vector3d& v) {
+  const double n = v.norm();
+  const Eigen::Vector3d h = v / n;
+  return (Eigen::Matrix3d::Identity() - h * h.transpose()) / n;
+}
+
+// H(v; u): Hessian of u·v̂ with respect to v (§3.4 group 1).
+Eigen::Matrix3d unit_hessian(const Eigen::Vector3d& v, const Eigen::Vector3d& u) {
+  const double n = v.norm();
+  const Eigen::Vector3d h = v / n;
+  const Eigen::Matrix3d Pi = Eigen::Matrix3d::Identity() - h * h.transpose();
+  const Eigen::Vector3d Piu = Pi * u;
+  return -(h * Piu.transpose() + Piu * h.transpose() + u.dot(h) * Pi) / (n * n);
+}
+
+void require_nondegenerate(const Eigen::Vector3d& v, double scale, const char* what) {
+  if (!(v.norm() > 1e-12 * scale) || !v.allFinite()) {
+    std::ostringstream os;
+    os << "CorotationalFrame: " << what << " has length " << v.norm()
+       << " (degenerate current element: corners collapsed or diagonals parallel); reject the iterate "
+          "and cut the step, or check the mesh";
+    throw std::domain_error(os.str());
+  }
+}
+
+}  // namespace
+
+CorotationalFrame::CorotationalFrame(const std::array<Eigen::Vector3d, 9>& x,
+                                     const std::array<Eigen::Vector3d, 9>& p,
+                                     const std::array<Eigen::Matrix<double, 3, 2>, 9>& A1,
+                                     const std::array<Eigen::Matrix2d, 9>& d2pl,
+                                     const std::array<DirectorChart, 9>& charts)
+    : p_(p), A1_(A1), d2pl_(d2pl) {
+  for (int i = 0; i < 9; ++i) l_[i] = charts[i].l;
+  // §3.1 triad from the unit diagonals.
+  a_ = x[2] - x[0];
+  b_ = x[3] - x[1];
+  require_nondegenerate(a_, 1.0, "diagonal x3 - x1");
+  require_nondegenerate(b_, 1.0, "diagonal x4 - x2");
+  const Eigen::Vector3d ah = a_.normalized(), bh = b_.normalized();
+  s_ = ah - bh;
+  c_ = ah + bh;
+  // |s|^2 + |c|^2 = 4, so one of them is small only for (anti)parallel diagonals.
+  require_nondegenerate(s_, 1.0, "difference of the unit diagonals");
+  require_nondegenerate(c_, 1.0, "sum of the unit diagonals");
+  const Eigen::Vector3d ex = s_.normalized(), ey = c_.normalized();
+  R_.col(0) = ex;
+  R_.col(1) = ey;
+  R_.col(2) = ex.cross(ey);
+  xO_ = 0.25 * (x[0] + x[1] + x[2] + x[3]);
+  for (int i = 0; i < 9; ++i) rel_[i] = x[i] - xO_;
+
+  // §3.3 frame derivatives, per corner: G_a = [-I 0 I 0], G_b = [0 -I 0 I].
+  Pa_ = unit_jacobian(a_);
+  Pb_ = unit_jacobian(b_);
+  Ps_ = unit_jacobian(s_);
+  Pc_ = unit_jacobian(c_);
+  const Eigen::Matrix3d PsPa = Ps_ * Pa_, PsPb = Ps_ * Pb_, PcPa = Pc_ * Pa_, PcPb = Pc_ * Pb_;
+  E_[0][0] = -PsPa, E_[0][2] = PsPa, E_[0][1] = PsPb, E_[0][3] = -PsPb;
+  E_[1][0] = -PcPa, E_[1][2] = PcPa, E_[1][1] = -PcPb, E_[1][3] = PcPb;
+  const Eigen::Matrix3d Sx = skew(ex), Sy = skew(ey);
+  for (int k = 0; k < 4; ++k) E_[2][k] = -Sy * E_[0][k] + Sx * E_[1][k];
+
+  // Factored T = D + C P (§3.3 blocks).
+  Eigen::Matrix<double, 2, 3> Exy;
+  Exy.row(0) = ex.transpose();
+  Exy.row(1) = ey.transpose();
+  C_.setZero();
+  for (int i = 0; i < 9; ++i) {
+    D_theta_[i] = Exy * A1_[i];  // ∂θ_i/∂q_i
+    for (int k = 0; k < 4; ++k) {
+      // ∂t_i/∂d_k (corner part): -¼R^T + C_ik, C_ik row α = (x_i - x_O)^T E_α,k.
+      Eigen::Matrix3d blk = -0.25 * R_.transpose();
+      for (int al = 0; al < 3; ++al) blk.row(al) += rel_[i].transpose() * E_[al][k];
+      C_.block<3, 3>(5 * i, 3 * k) = blk;
+      // ∂θ_i/∂d_k: row α = p_i^T E_α,k.
+      for (int al = 0; al < 2; ++al) C_.block<1, 3>(5 * i + 3 + al, 3 * k) = p_[i].transpose() * E_[al][k];
+    }
+  }
+}
+
+CorotationalFrame::Vec45 CorotationalFrame::local_variables(const std::array<Eigen::Vector3d, 9>& x_local0) const {
+  Vec45 u;
+  for (int i = 0; i < 9; ++i) {
+    u.segment<3>(5 * i) = R_.transpose() * rel_[i] - x_local0[i];
+    u(5 * i + 3) = R_.col(0).dot(p_[i]);
+    u(5 * i + 4) = R_.col(1).dot(p_[i]);
+  }
+  return u;
+}
+
+CorotationalFrame::Vec45 CorotationalFrame::apply_transpose(const Vec45& fL) const {
+  Vec45 F;
+  for (int i = 0; i < 9; ++i) {
+    F.segment<3>(5 * i) = R_ * fL.segment<3>(5 * i);
+    F.segment<2>(5 * i + 3) = D_theta_[i].transpose() * fL.segment<2>(5 * i + 3);
+  }
+  const Eigen::Matrix<double, 12, 1> Fc = C_.transpose() * fL;
+  for (int k = 0; k < 4; ++k) F.segment<3>(5 * k) += Fc.segment<3>(3 * k);
+  return F;
+}
+
+CorotationalFrame::Mat45 CorotationalFrame::matrix() const {
+  Mat45 T = Mat45::Zero();
+  for (int i = 0; i < 9; ++i) {
+    T.block<3, 3>(5 * i, 5 * i) = R_.transpose();
+    T.block<2, 2>(5 * i + 3, 5 * i + 3) = D_theta_[i];
+  }
+  for (int k = 0; k < 4; ++k) T.middleCols<3>(5 * k) += C_.middleCols<3>(3 * k);
+  return T;
+}
+
+void CorotationalFrame::tangent(const Mat45& kL, const Vec45& fL, bool geometric, Mat45* K) const {
+  // T^T k_L T exploiting T = D + C P: ~7e4 multiplications instead of 1.8e5 for dense products.
+  Mat45 kT;
+  const Eigen::Matrix3d Rt = R_.transpose();
+  for (int j = 0; j < 9; ++j) {
+    kT.middleCols<3>(5 * j).noalias() = kL.middleCols<3>(5 * j) * Rt;
+    kT.middleCols<2>(5 * j + 3).noalias() = kL.middleCols<2>(5 * j + 3) * D_theta_[j];
+  }
+  const Eigen::Matrix<double, 45, 12> kC = kL * C_;
+  for (int k = 0; k < 4; ++k) kT.middleCols<3>(5 * k) += kC.middleCols<3>(3 * k);
+  for (int i = 0; i < 9; ++i) {
+    K->middleRows<3>(5 * i).noalias() = R_ * kT.middleRows<3>(5 * i);
+    K->middleRows<2>(5 * i + 3).noalias() = D_theta_[i].transpose() * kT.middleRows<2>(5 * i + 3);
+  }
+  const Eigen::Matrix<double, 12, 45> CtkT = C_.transpose() * kT;
+  for (int k = 0; k < 4; ++k) K->middleRows<3>(5 * k) += CtkT.middleRows<3>(3 * k);
+  if (geometric) add_geometric_stiffness(fL, K);
+}
+
+void CorotationalFrame::add_geometric_stiffness(const Vec45& fL, Mat45* K) const {
+  // K_σ = Σ_j (f_L)_j ∂²(u_L)_j/∂u_G∂u_G, §3.4. Weight vectors:
+  Eigen::Vector3d wx = Eigen::Vector3d::Zero(), wy = Eigen::Vector3d::Zero(), wz = Eigen::Vector3d::Zero();
+  for (int i = 0; i < 9; ++i) {
+    wx += fL(5 * i) * rel_[i] + fL(5 * i + 3) * p_[i];
+    wy += fL(5 * i + 1) * rel_[i] + fL(5 * i + 4) * p_[i];
+    wz += fL(5 * i + 2) * rel_[i];
+  }
+  const Eigen::Vector3d ex = R_.col(0), ey = R_.col(1);
+
+  // Group 1: corner-corner, from the second derivatives of e_x, e_y, e_z = e_x × e_y.
+  const Eigen::Vector3d wxh = wx + ey.cross(wz), wyh = wy + wz.cross(ex);
+  Mat312 Ga = Mat312::Zero(), Gb = Mat312::Zero();
+  Ga.block<3, 3>(0, 0) = -Eigen::Matrix3d::Identity();
+  Ga.block<3, 3>(0, 6) = Eigen::Matrix3d::Identity();
+  Gb.block<3, 3>(0, 3) = -Eigen::Matrix3d::Identity();
+  Gb.block<3, 3>(0, 9) = Eigen::Matrix3d::Identity();
+  const Mat312 Gs = Pa_ * Ga - Pb_ * Gb, Gc = Pa_ * Ga + Pb_ * Gb;
+  const Mat312 Gx = Ps_ * Gs, Gy = Pc_ * Gc;
+  const Eigen::Matrix<double, 12, 12> S = -Gx.transpose() * skew(wz) * Gy;
+  const Eigen::Matrix<double, 12, 12> Kcc =
+      Gs.transpose() * unit_hessian(s_, wxh) * Gs + Gc.transpose() * unit_hessian(c_, wyh) * Gc +
+      Ga.transpose() * unit_hessian(a_, Ps_ * wxh + Pc_ * wyh) * Ga +
+      Gb.transpose() * unit_hessian(b_, -Ps_ * wxh + Pc_ * wyh) * Gb + S + S.transpose();
+  for (int k = 0; k < 4; ++k)
+    for (int j = 0; j < 4; ++j) K->block<3, 3>(5 * k, 5 * j) += Kcc.block<3, 3>(3 * k, 3 * j);
+
+  for (int i = 0; i < 9; ++i) {
+    const Eigen::Vector3d ft = fL.segment<3>(5 * i);
+    const Eigen::Vector2d fth = fL.segment<2>(5 * i + 3);
+    for (int k = 0; k < 4; ++k) {
+      // Group 2: corner k × translation of node i through t_i = R^T(x_i - x_O), incl. the -¼ origin terms.
+      const Eigen::Matrix3d M =
+          ft(0) * E_[0][k].transpose() + ft(1) * E_[1][k].transpose() + ft(2) * E_[2][k].transpose();
+      K->block<3, 3>(5 * k, 5 * i) += M;
+      K->block<3, 3>(5 * i, 5 * k) += M.transpose();
+      for (int j = 0; j < 4; ++j) {
+        K->block<3, 3>(5 * k, 5 * j) -= 0.25 * M;
+        K->block<3, 3>(5 * j, 5 * k) -= 0.25 * M.transpose();
+      }
+      // Group 3: corner k × director of node i through θ_i = (e_x·p_i, e_y·p_i).
+      const Eigen::Matrix<double, 3, 2> N = (fth(0) * E_[0][k].transpose() + fth(1) * E_[1][k].transpose()) * A1_[i];
+      K->block<3, 2>(5 * k, 5 * i + 3) += N;
+      K->block<2, 3>(5 * i + 3, 5 * k) += N.transpose();
+    }
+    // Group 4: director × director of the same node, through the curvature of p_l(q).
+    K->block<2, 2>(5 * i + 3, 5 * i + 3) += (fth(0) * ex(l_[i]) + fth(1) * ey(l_[i])) * d2pl_[i];
+  }
+}
+
+}  // namespace shelldyn

@@ -1,0 +1,62 @@
+// Co-rotational frame of the 9-node element and the global <-> local map (spec/element.md §3).
+//
+// The element triad follows the unit diagonals of the current corner positions (§3.1):
+//   a = x3 - x1, b = x4 - x2, e_x = (â - b̂)/|â - b̂|, e_y = (â + b̂)/|â + b̂|, e_z = e_x × e_y,
+// with origin x_O = corner centroid. Local variables per node (§3.2): t_i = R^T (x_i - x_O) - x_i0 and
+// θ_i = (e_x·p_i, e_y·p_i). T = ∂u_L/∂u_G (§3.3) is stored in factored form T = D + C P:
+// D is block diagonal (R^T on t_i/d_i, [e_x e_y]^T A1_i on θ_i/q_i) and C (45x12) holds the
+// dependence of every local variable on the 4 corner translations through the triad and x_O.
+// Node-major DOF order, 5 per node: global [d_X,d_Y,d_Z,q_1,q_2], local [t_x,t_y,t_z,θ_x,θ_y].
+#pragma once
+
+#include <Eigen/Core>
+#include <array>
+
+#include "elements/director.hpp"
+
+namespace shelldyn {
+
+class CorotationalFrame {
+ public:
+  using Vec45 = Eigen::Matrix<double, 45, 1>;
+  using Mat45 = Eigen::Matrix<double, 45, 45>;
+
+  // x: current nodal positions; p, A1, d2pl, charts: current nodal directors with dp/dq and the
+  // second derivative of their dependent component (§2.2). Throws std::domain_error if the current
+  // corners are degenerate (zero-length or parallel diagonals).
+  CorotationalFrame(const std::array<Eigen::Vector3d, 9>& x, const std::array<Eigen::Vector3d, 9>& p,
+                    const std::array<Eigen::Matrix<double, 3, 2>, 9>& A1,
+                    const std::array<Eigen::Matrix2d, 9>& d2pl, const std::array<DirectorChart, 9>& charts);
+
+  const Eigen::Matrix3d& R() const { return R_; }
+  const Eigen::Vector3d& origin() const { return xO_; }
+
+  // Local variables (§3.2): t_i = R^T(x_i - x_O) - x_i0 and θ_i (absolute, not the increment).
+  Vec45 local_variables(const std::array<Eigen::Vector3d, 9>& x_local0) const;
+
+  // F_G = T^T f_L (§3.4).
+  Vec45 apply_transpose(const Vec45& fL) const;
+  // K_G = T^T k_L T + K_σ(f_L) (§3.4); geometric = false drops K_σ (test switch only).
+  void tangent(const Mat45& kL, const Vec45& fL, bool geometric, Mat45* K) const;
+  // K_σ(f_L) alone, added into *K (§3.4 groups 1-4).
+  void add_geometric_stiffness(const Vec45& fL, Mat45* K) const;
+  // Dense T (for tests and diagnostics).
+  Mat45 matrix() const;
+
+  // ∂e_α/∂d_k for α = x,y,z and corner k = 0..3 (§3.3).
+  const Eigen::Matrix3d& dE(int alpha, int corner) const { return E_[alpha][corner]; }
+
+ private:
+  std::array<Eigen::Vector3d, 9> rel_;  // x_i - x_O
+  std::array<Eigen::Vector3d, 9> p_;
+  std::array<Eigen::Matrix<double, 3, 2>, 9> A1_;
+  std::array<Eigen::Matrix2d, 9> d2pl_;
+  std::array<int, 9> l_;
+  Eigen::Vector3d xO_, a_, b_, s_, c_;
+  Eigen::Matrix3d R_, Pa_, Pb_, Ps_, Pc_;
+  std::array<std::array<Eigen::Matrix3d, 4>, 3> E_;
+  std::array<Eigen::Matrix<double, 2, 2>, 9> D_theta_;  // [e_x e_y]^T A1_i
+  Eigen::Matrix<double, 45, 12> C_;                     // corner columns of T beyond D
+};
+
+}  // namespace shelldyn

@@ -1,0 +1,418 @@
+// CR9 shell element: spec/element.md §2.4 (set-up), §3.4 (global force/tangent), §4 (local strains,
+// MITC9, resultants), §5 (inertia), §6.3 (strain-averaged algorithmic force).
+#include "elements/cr9_shell.hpp"
+
+#include <Eigen/Geometry>
+#include <Eigen/LU>
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+
+#include "elements/mitc9.hpp"
+#include "elements/shape_functions.hpp"
+
+namespace shelldyn {
+
+namespace {
+
+using Row27 = Eigen::Matrix<double, 1, 27>;
+using Row45 = Eigen::Matrix<double, 1, 45>;
+using Mat9 = Eigen::Matrix<double, 9, 9>;
+
+// Covariant strain functionals at one point (§4.3). Index ab: 0 = ξξ, 1 = ηη, 2 = ξη.
+// Membrane e_ab = eL[ab]·t + ½ Σ_ij eH[ab](i,j) t_i·t_j (t = local translations, node-major 27-vector);
+// bending k_ab = k[ab]·w, shear g_a = g[a]·w (w = [t_i, Δθ_i], node-major 45-vector).
+struct Covariant {
+  std::array<Row27, 3> eL;
+  std::array<Mat9, 3> eH;
+  std::array<Row45, 3> k;
+  std::array<Row45, 2> g;
+  Eigen::Vector3d Xa[2];
+};
+
+Covariant covariant(double xi, double eta, const std::array<Eigen::Vector3d, 9>& x0,
+                    const std::array<Eigen::Vector3d, 9>& r0, const std::array<Eigen::Matrix<double, 3, 2>, 9>& L) {
+  const Eigen::Matrix<double, 9, 1> N = shape_functions(xi, eta);
+  const Eigen::Matrix<double, 9, 2> dN = shape_derivatives(xi, eta);
+  // §4.2 reference geometry at the point.
+  Eigen::Vector3d Xa[2] = {Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
+  Eigen::Vector3d Aa[2] = {Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
+  Eigen::Vector3d A = Eigen::Vector3d::Zero();
+  for (int i = 0; i < 9; ++i) {
+    A += N(i) * r0[i];
+    for (int a = 0; a < 2; ++a) Xa[a] += dN(i, a) * x0[i], Aa[a] += dN(i, a) * r0[i];
+  }
+  Covariant c;
+  c.Xa[0] = Xa[0];
+  c.Xa[1] = Xa[1];
+  const int ia[3] = {0, 1, 0}, ib[3] = {0, 1, 1};
+  for (int ab = 0; ab < 3; ++ab) {
+    const int a = ia[ab], b = ib[ab];
+    c.k[ab].setZero();
+    for (int i = 0; i < 9; ++i) {
+      // ∂e_ab/∂t_i (linear part), ∂k_ab/∂t_i, ∂k_ab/∂Δθ_i (§4.3 derivative list).
+      c.eL[ab].segment<3>(3 * i) = 0.5 * (dN(i, b) * Xa[a] + dN(i, a) * Xa[b]).transpose();
+      c.k[ab].segment<3>(5 * i) = 0.5 * (dN(i, b) * Aa[a] + dN(i, a) * Aa[b]).transpose();
+      c.k[ab].segment<2>(5 * i + 3) = 0.5 * (dN(i, b) * Xa[a] + dN(i, a) * Xa[b]).transpose() * L[i];
+      for (int j = 0; j < 9; ++j) c.eH[ab](i, j) = 0.5 * (dN(i, a) * dN(j, b) + dN(i, b) * dN(j, a));
+    }
+  }
+  for (int a = 0; a < 2; ++a) {
+    c.g[a].setZero();
+    for (int i = 0; i < 9; ++i) {
+      c.g[a].segment<3>(5 * i) = dN(i, a) * A.transpose();              // ∂g_a/∂t_i = N_i,a A^T
+      c.g[a].segment<2>(5 * i + 3) = N(i) * Xa[a].transpose() * L[i];  // ∂g_a/∂Δθ_i = N_i X,a^T L_i
+    }
+  }
+  return c;
+}
+
+std::string node_name(int i) { return "node " + std::to_string(i + 1) + " (index " + std::to_string(i) + ")"; }
+
+void validate_material(const ShellMaterial& m) {
+  auto fail = [](const std::string& what) {
+    throw std::invalid_argument("CR9Shell: invalid material: " + what);
+  };
+  if (!(m.E > 0.0) || !std::isfinite(m.E)) fail("E = " + std::to_string(m.E) + " must be finite and > 0");
+  if (!(m.nu > -1.0 && m.nu < 0.5)) fail("nu = " + std::to_string(m.nu) + " must lie in (-1, 0.5)");
+  if (!(m.rho >= 0.0) || !std::isfinite(m.rho)) fail("rho = " + std::to_string(m.rho) + " must be finite and >= 0");
+  if (!(m.thickness > 0.0) || !std::isfinite(m.thickness))
+    fail("thickness = " + std::to_string(m.thickness) + " must be finite and > 0");
+  if (!(m.shear_factor > 0.0) || !std::isfinite(m.shear_factor))
+    fail("shear_factor = " + std::to_string(m.shear_factor) + " must be finite and > 0 (usually 5/6)");
+}
+
+}  // namespace
+
+CR9Shell::CR9Shell(const std::array<Eigen::Vector3d, 9>& X0, const std::array<Eigen::Vector3d, 9>& p0,
+                   const ShellMaterial& mat, Options opt)
+    : X0_(X0), mat_(mat), opt_(opt) {
+  validate_material(mat);
+  for (int i = 0; i < 9; ++i) {
+    if (!X0[i].allFinite()) throw std::invalid_argument("CR9Shell: X0 of " + node_name(i) + " is not finite");
+    if (!p0[i].allFinite() || std::abs(p0[i].norm() - 1.0) > 1e-8) {
+      std::ostringstream os;
+      os << "CR9Shell: initial normal p0 of " << node_name(i) << " = (" << p0[i].transpose() << ") has length "
+         << p0[i].norm() << "; pass unit normals (normalise after averaging, spec §2.4)";
+      throw std::invalid_argument(os.str());
+    }
+  }
+  // §3.1 initial triad R_0 and origin.
+  const Eigen::Vector3d a = X0[2] - X0[0], b = X0[3] - X0[1];
+  const double len = std::max(a.norm(), b.norm());
+  if (!(a.norm() > 1e-10 * len) || !(b.norm() > 1e-10 * len) || !(len > 0.0))
+    throw std::invalid_argument("CR9Shell: degenerate element: a corner diagonal (x3-x1 or x4-x2) has zero length");
+  const Eigen::Vector3d s = a.normalized() - b.normalized(), c = a.normalized() + b.normalized();
+  if (!(s.norm() > 1e-8) || !(c.norm() > 1e-8))
+    throw std::invalid_argument("CR9Shell: degenerate element: the corner diagonals are parallel");
+  Eigen::Matrix3d R0;
+  R0.col(0) = s.normalized();
+  R0.col(1) = c.normalized();
+  R0.col(2) = R0.col(0).cross(R0.col(1));
+  const Eigen::Vector3d xO = 0.25 * (X0[0] + X0[1] + X0[2] + X0[3]);
+
+  std::array<Eigen::Vector3d, 9> r0;
+  std::array<Eigen::Matrix<double, 3, 2>, 9> L;
+  for (int i = 0; i < 9; ++i) {
+    xl0_[i] = R0.transpose() * (X0[i] - xO);
+    r0[i] = R0.transpose() * p0[i];
+    // §2.4 orientation requirement: r_i0,z = e_z0·p_i0 > 0.
+    if (!(r0[i](2) > 0.0)) {
+      std::ostringstream os;
+      os << "CR9Shell: orientation check failed at " << node_name(i) << ": e_z0·p0 = " << r0[i](2)
+         << " <= 0 (element normal from the corner numbering points away from the nodal normal); number the "
+            "corners counter-clockwise seen from the normal side, or flip the element (spec §2.4)";
+      throw std::invalid_argument(os.str());
+    }
+    th0_[i] = r0[i].head<2>();
+    // §4.3 linearised director increment Δr_i = L_i Δθ_i (third row from r_i0·Δr_i = 0).
+    L[i] << 1.0, 0.0, 0.0, 1.0, -r0[i](0) / r0[i](2), -r0[i](1) / r0[i](2);
+  }
+
+  // §4.4 tying-point strain functionals.
+  std::array<std::array<Covariant, 6>, 3> tying;
+  for (int f = 0; f < 3; ++f) {
+    const Mitc9Family& fam = mitc9_family(f);
+    for (int k = 0; k < fam.count; ++k) tying[f][k] = covariant(fam.xi[k], fam.eta[k], xl0_, r0, L);
+  }
+
+  const double h = mat.thickness;
+  const double G = mat.E / (2.0 * (1.0 + mat.nu));
+  D1_ << 1.0, mat.nu, 0.0, mat.nu, 1.0, 0.0, 0.0, 0.0, 0.5 * (1.0 - mat.nu);
+  D1_ *= mat.E / (1.0 - mat.nu * mat.nu);
+  const Eigen::Matrix3d Db = (h * h * h / 12.0) * D1_;
+  const double Ds = mat.shear_factor * G * h;
+
+  Kbs_.setZero();
+  m_.setZero();
+  area_ = 0.0;
+  const auto& gx = gauss3_points();
+  const auto& gw = gauss3_weights();
+  for (int ig = 0; ig < 3; ++ig) {
+    for (int jg = 0; jg < 3; ++jg) {
+      const double xi = gx[ig], eta = gx[jg];
+      const Covariant cg = covariant(xi, eta, xl0_, r0, L);
+      // Assumed (tied) covariant membrane and shear strains at the Gauss point (§4.4).
+      std::array<Row27, 3> eL;
+      std::array<Mat9, 3> eH;
+      std::array<Row45, 2> g;
+      if (opt_.mitc) {
+        const int fam_e[3] = {0, 1, 2};
+        for (int ab = 0; ab < 3; ++ab) {
+          const int f = fam_e[ab];
+          const Eigen::Matrix<double, 6, 1> w = mitc9_weights(f, xi, eta);
+          eL[ab].setZero();
+          eH[ab].setZero();
+          for (int k = 0; k < mitc9_family(f).count; ++k) {
+            eL[ab] += w(k) * tying[f][k].eL[ab];
+            eH[ab] += w(k) * tying[f][k].eH[ab];
+          }
+        }
+        for (int a = 0; a < 2; ++a) {  // g_ξ from family A, g_η from family B
+          const Eigen::Matrix<double, 6, 1> w = mitc9_weights(a, xi, eta);
+          g[a].setZero();
+          for (int k = 0; k < 6; ++k) g[a] += w(k) * tying[a][k].g[a];
+        }
+      } else {
+        eL = cg.eL;
+        eH = cg.eH;
+        g = cg.g;
+      }
+      // §4.5 orthonormal tangent basis and Cartesian components.
+      const Eigen::Vector3d t1 = cg.Xa[0].normalized();
+      const Eigen::Vector3d nrm = cg.Xa[0].cross(cg.Xa[1]);
+      if (!(nrm.norm() > 1e-12 * cg.Xa[0].squaredNorm()) || !(nrm(2) > 0.0)) {
+        std::ostringstream os;
+        os << "CR9Shell: degenerate or folded element: at Gauss point (" << xi << ", " << eta
+           << ") the mid-surface Jacobian has normal (" << nrm.transpose()
+           << ") in the element frame; check node positions and the counter-clockwise numbering (spec §1)";
+        throw std::invalid_argument(os.str());
+      }
+      const Eigen::Vector3d t2 = nrm.normalized().cross(t1);
+      Eigen::Matrix2d J;
+      J << cg.Xa[0].dot(t1), cg.Xa[0].dot(t2), cg.Xa[1].dot(t1), cg.Xa[1].dot(t2);
+      const Eigen::Matrix2d j = J.inverse();
+      const double dA = J.determinant() * gw[ig] * gw[jg];
+      // Tensor transformation [e_ξξ, e_ηη, e_ξη] -> [ε_11, ε_22, 2ε_12] with j_αa.
+      Eigen::Matrix3d Tm;
+      Tm << j(0, 0) * j(0, 0), j(0, 1) * j(0, 1), 2.0 * j(0, 0) * j(0, 1),  //
+          j(1, 0) * j(1, 0), j(1, 1) * j(1, 1), 2.0 * j(1, 0) * j(1, 1),      //
+          2.0 * j(0, 0) * j(1, 0), 2.0 * j(0, 1) * j(1, 1), 2.0 * (j(0, 0) * j(1, 1) + j(0, 1) * j(1, 0));
+      GaussPoint& gp = gp_[3 * ig + jg];
+      gp.dA = dA;
+      for (int c = 0; c < 3; ++c) {
+        gp.Lm.row(c) = Tm(c, 0) * eL[0] + Tm(c, 1) * eL[1] + Tm(c, 2) * eL[2];
+        gp.Hm[c] = Tm(c, 0) * eH[0] + Tm(c, 1) * eH[1] + Tm(c, 2) * eH[2];
+      }
+      Eigen::Matrix<double, 3, 45> Bb;
+      for (int c = 0; c < 3; ++c) Bb.row(c) = Tm(c, 0) * cg.k[0] + Tm(c, 1) * cg.k[1] + Tm(c, 2) * cg.k[2];
+      Eigen::Matrix<double, 2, 45> Bs;
+      for (int al = 0; al < 2; ++al) Bs.row(al) = j(al, 0) * g[0] + j(al, 1) * g[1];
+      // §4.7 constant parts of k_L: B_b^T (h^3 D1/12) B_b + B_s^T (h D2) B_s.
+      Kbs_.noalias() += dA * (Bb.transpose() * Db * Bb + Ds * Bs.transpose() * Bs);
+      const Eigen::Matrix<double, 9, 1> N = shape_functions(xi, eta);
+      m_.noalias() += dA * N * N.transpose();  // §5.1 m_ij
+      area_ += dA;
+    }
+  }
+  Kbs_ = 0.5 * (Kbs_ + Kbs_.transpose()).eval();
+}
+
+CorotationalFrame CR9Shell::local_increments(const Vec45& u, const Charts& charts, Vec45* w) const {
+  std::array<Eigen::Vector3d, 9> x, p;
+  std::array<Eigen::Matrix<double, 3, 2>, 9> A1;
+  std::array<Eigen::Matrix2d, 9> d2;
+  for (int i = 0; i < 9; ++i) {
+    const Eigen::Vector2d q = u.segment<2>(5 * i + 3);
+    x[i] = X0_[i] + u.segment<3>(5 * i);
+    p[i] = director(q, charts[i]);
+    A1[i] = director_A1(q, charts[i]);
+    d2[i] = director_d2pl(q, charts[i]);
+  }
+  CorotationalFrame fr(x, p, A1, d2, charts);
+  if (w) {
+    *w = fr.local_variables(xl0_);
+    for (int i = 0; i < 9; ++i) w->segment<2>(5 * i + 3) -= th0_[i];  // Δθ_i = θ_i - θ_i0 (§2.5)
+  }
+  return fr;
+}
+
+CorotationalFrame CR9Shell::frame(const Vec45& u, const Charts& charts) const {
+  return local_increments(u, charts, nullptr);
+}
+
+double CR9Shell::membrane(const Mat39& t1, const Mat39& t0, double c1, double c0, const Mat39& tbar, Vec45* fL,
+                          Mat45* kL) const {
+  const Eigen::Matrix3d hD1 = mat_.thickness * D1_;
+  Eigen::Matrix<double, 27, 1> fm = Eigen::Matrix<double, 27, 1>::Zero();
+  Eigen::Matrix<double, 27, 27> km;
+  Mat9 Hs;
+  if (kL) km.setZero(), Hs.setZero();
+  const Eigen::Map<const Eigen::Matrix<double, 27, 1>> v1(t1.data()), v0(t0.data());
+  double U = 0.0;
+  for (const GaussPoint& gp : gp_) {
+    // ε_m,c = L_m,c·t + ½ Σ_ij H_c(i,j) t_i·t_j (quadratic, §4.7); gradient B_m = L_m + H_m t.
+    Eigen::Vector3d e1, e0 = Eigen::Vector3d::Zero();
+    Eigen::Matrix<double, 3, 27> Bm;
+    for (int c = 0; c < 3; ++c) {
+      const Mat39 tH1 = t1 * gp.Hm[c];
+      e1(c) = gp.Lm.row(c).dot(v1) + 0.5 * tH1.cwiseProduct(t1).sum();
+      if (c0 != 0.0) {
+        const Mat39 tH0 = t0 * gp.Hm[c];
+        e0(c) = gp.Lm.row(c).dot(v0) + 0.5 * tH0.cwiseProduct(t0).sum();
+      }
+      const Mat39 tHb = tbar * gp.Hm[c];
+      Bm.row(c) = gp.Lm.row(c) + Eigen::Map<const Row27>(tHb.data());
+    }
+    const Eigen::Vector3d N = hD1 * (c1 * e1 + c0 * e0);  // N* = h D1 ε*_m (§6.3)
+    U += 0.5 * gp.dA * e1.dot(hD1 * e1);
+    fm.noalias() += gp.dA * Bm.transpose() * N;
+    if (kL) {
+      km.noalias() += gp.dA * Bm.transpose() * hD1 * Bm;
+      Hs += gp.dA * (N(0) * gp.Hm[0] + N(1) * gp.Hm[1] + N(2) * gp.Hm[2]);  // Σ_c N_c H_m,c
+    }
+  }
+  if (fL)
+    for (int i = 0; i < 9; ++i) fL->segment<3>(5 * i) += fm.segment<3>(3 * i);
+  if (kL)
+    for (int i = 0; i < 9; ++i)
+      for (int j = 0; j < 9; ++j) {
+        kL->block<3, 3>(5 * i, 5 * j) += km.block<3, 3>(3 * i, 3 * j);
+        kL->block<3, 3>(5 * i, 5 * j).diagonal().array() += Hs(i, j);
+      }
+  return U;
+}
+
+namespace {
+Eigen::Matrix<double, 3, 9> translations(const Eigen::Matrix<double, 45, 1>& w) {
+  Eigen::Matrix<double, 3, 9> t;
+  for (int i = 0; i < 9; ++i) t.col(i) = w.segment<3>(5 * i);
+  return t;
+}
+}  // namespace
+
+double CR9Shell::local(const Vec45& u, const Charts& charts, Vec45* uL, Vec45* fL, Mat45* kL) const {
+  Vec45 w;
+  const CorotationalFrame fr = local_increments(u, charts, &w);
+  if (uL) *uL = fr.local_variables(xl0_);
+  Vec45 f = Kbs_ * w;  // bending + shear: f = K_bs w (linear, §4.7)
+  double U = 0.5 * w.dot(f);
+  if (kL) *kL = Kbs_;
+  const Mat39 t = translations(w);
+  U += membrane(t, t, 1.0, 0.0, t, &f, kL);
+  if (fL) *fL = f;
+  return U;
+}
+
+double CR9Shell::internal(const Vec45& u, const Charts& charts, Vec45* F, Mat45* K) const {
+  Vec45 w;
+  const CorotationalFrame fr = local_increments(u, charts, &w);
+  Vec45 fL = Kbs_ * w;
+  double U = 0.5 * w.dot(fL);
+  const Mat39 t = translations(w);
+  if (K) {
+    Mat45 kL = Kbs_;
+    U += membrane(t, t, 1.0, 0.0, t, &fL, &kL);
+    fr.tangent(kL, fL, opt_.geometric_stiffness, K);  // §3.4 K = T^T k_L T + K_σ
+  } else {
+    U += membrane(t, t, 1.0, 0.0, t, &fL, nullptr);
+  }
+  if (F) *F = fr.apply_transpose(fL);  // §3.4 F = T^T f_L
+  return U;
+}
+
+double CR9Shell::algorithmic_internal(const Vec45& u_n, const Vec45& u_np1, const Charts& charts, double alpha_f,
+                                      double xi, Vec45* F, Mat45* K) const {
+  if (!(alpha_f >= 0.0 && alpha_f <= 1.0) || !std::isfinite(xi)) {
+    std::ostringstream os;
+    os << "CR9Shell::algorithmic_internal: alpha_f = " << alpha_f << " must lie in [0,1] and xi = " << xi
+       << " must be finite";
+    throw std::invalid_argument(os.str());
+  }
+  // §6.3 steps 1-5: local states from each end configuration (same charts), strain averaging,
+  // strain gradient at w̄ = (1-α_f) w_1 + α_f w_n, T and K_σ at u_mid.
+  Vec45 wn, w1;
+  local_increments(u_n, charts, &wn);
+  local_increments(u_np1, charts, &w1);
+  const Vec45 u_mid = (1.0 - alpha_f) * u_np1 + alpha_f * u_n;
+  const CorotationalFrame fr = local_increments(u_mid, charts, nullptr);
+  const double c1 = 1.0 - alpha_f + xi, c0 = alpha_f - xi;
+  const Vec45 wbar = (1.0 - alpha_f) * w1 + alpha_f * wn;
+  Vec45 fL = Kbs_ * (c1 * w1 + c0 * wn);  // B_b^T M* + B_s^T Q* (B_b, B_s constant)
+  double U = 0.5 * w1.dot(Kbs_ * w1);
+  const Mat39 t1 = translations(w1), t0 = translations(wn), tb = translations(wbar);
+  if (K) {
+    Mat45 kL = Kbs_;
+    U += membrane(t1, t0, c1, c0, tb, &fL, &kL);
+    fr.tangent(kL, fL, opt_.geometric_stiffness, K);
+  } else {
+    U += membrane(t1, t0, c1, c0, tb, &fL, nullptr);
+  }
+  if (F) *F = fr.apply_transpose(fL);
+  return U;
+}
+
+void CR9Shell::mass(const Vec45& u, const Charts& charts, Mat45* M) const {
+  const double rh = mat_.rho * mat_.thickness;
+  const double rh3 = rh * mat_.thickness * mat_.thickness / 12.0;
+  std::array<Eigen::Matrix<double, 3, 2>, 9> A1;
+  for (int i = 0; i < 9; ++i) A1[i] = director_A1(u.segment<2>(5 * i + 3), charts[i]);
+  M->setZero();
+  for (int i = 0; i < 9; ++i)
+    for (int j = 0; j < 9; ++j) {
+      // §5.2 node-pair block: ρh m_ij I_3 and (ρh³/12) m_ij A1_i^T A1_j.
+      M->block<3, 3>(5 * i, 5 * j).diagonal().setConstant(rh * m_(i, j));
+      M->block<2, 2>(5 * i + 3, 5 * j + 3).noalias() = (rh3 * m_(i, j)) * A1[i].transpose() * A1[j];
+    }
+}
+
+void CR9Shell::inertial(const Vec45& u, const Vec45& v, const Charts& charts, Vec45* Fm) const {
+  const double rh3 = mat_.rho * std::pow(mat_.thickness, 3) / 12.0;
+  std::array<Eigen::Vector3d, 9> A2;
+  for (int j = 0; j < 9; ++j) A2[j] = director_A2(u.segment<2>(5 * j + 3), v.segment<2>(5 * j + 3), charts[j]);
+  Fm->setZero();
+  for (int i = 0; i < 9; ++i) {
+    Eigen::Vector3d s = Eigen::Vector3d::Zero();
+    for (int j = 0; j < 9; ++j) s += m_(i, j) * A2[j];
+    // §5.2: F_m at node i = (ρh³/12) A1_i^T Σ_j m_ij A2_j (no translational part).
+    Fm->segment<2>(5 * i + 3) = rh3 * director_A1(u.segment<2>(5 * i + 3), charts[i]).transpose() * s;
+  }
+}
+
+double CR9Shell::kinetic(const Vec45& u, const Vec45& v, const Charts& charts) const {
+  const double rh = mat_.rho * mat_.thickness;
+  const double rh3 = rh * mat_.thickness * mat_.thickness / 12.0;
+  Eigen::Matrix<double, 3, 9> dd, pd;
+  for (int i = 0; i < 9; ++i) {
+    dd.col(i) = v.segment<3>(5 * i);
+    pd.col(i) = director_A1(u.segment<2>(5 * i + 3), charts[i]) * v.segment<2>(5 * i + 3);  // ṗ = A1 q̇
+  }
+  // §5.1: K = ½ρh Σ m_ij ḋ_i·ḋ_j + ½(ρh³/12) Σ m_ij ṗ_i·ṗ_j.
+  return 0.5 * rh * (dd * m_ * dd.transpose()).trace() + 0.5 * rh3 * (pd * m_ * pd.transpose()).trace();
+}
+
+void CR9Shell::momenta(const Vec45& u, const Vec45& v, const Charts& charts, Eigen::Vector3d* L,
+                       Eigen::Vector3d* J) const {
+  const double rh = mat_.rho * mat_.thickness;
+  const double h2 = mat_.thickness * mat_.thickness / 12.0;
+  Eigen::Matrix<double, 3, 9> dd, pd, x, p;
+  for (int i = 0; i < 9; ++i) {
+    const Eigen::Vector2d q = u.segment<2>(5 * i + 3);
+    dd.col(i) = v.segment<3>(5 * i);
+    x.col(i) = X0_[i] + u.segment<3>(5 * i);
+    p.col(i) = director(q, charts[i]);
+    pd.col(i) = director_A1(q, charts[i]) * v.segment<2>(5 * i + 3);
+  }
+  // §5.4: L = Σ ρh m_ij ḋ_j, J = Σ ρh m_ij [x_i × ḋ_j + (h²/12) p_i × ṗ_j].
+  const Eigen::Matrix<double, 3, 9> mdd = dd * m_, mpd = pd * m_;  // column i = Σ_j m_ij ḋ_j (m symmetric)
+  if (L) *L = rh * mdd.rowwise().sum();
+  if (J) {
+    Eigen::Vector3d s = Eigen::Vector3d::Zero();
+    for (int i = 0; i < 9; ++i)
+      s += Eigen::Vector3d(x.col(i)).cross(Eigen::Vector3d(mdd.col(i))) +
+           h2 * Eigen::Vector3d(p.col(i)).cross(Eigen::Vector3d(mpd.col(i)));
+    *J = rh * s;
+  }
+}
+
+}  // namespace shelldyn

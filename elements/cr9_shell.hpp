@@ -1,0 +1,111 @@
+// CR9: co-rotational 9-node shell element with vectorial rotational variables
+// (spec/element.md §§1-6.3; Li & Qian 2025, Li, Izzuddin & Vu-Quoc 2008), MITC9 assumed strains.
+//
+// Node numbering (spec §1, Gmsh type 10; 0-based index in code = node - 1):
+//
+//      4 ---- 7 ---- 3        eta
+//      |             |         ^
+//      8      9      6         |
+//      |             |         +--> xi
+//      1 ---- 5 ---- 2
+//
+// Corners run counter-clockwise seen from the side the initial normals p_i0 point to (§2.4).
+// DOFs, node-major, 5 per node: [d_X, d_Y, d_Z, q_1, q_2]; d = translation from X0, q = the two minor
+// components of the CURRENT unit director in the node's DirectorChart (§2.1).
+//
+// Units: any consistent set (E in force/length^2, rho in mass/length^3, thickness in length).
+// Ownership: the element owns only precomputed reference-geometry data; all methods are const, pure
+// and thread-safe, and allocate no heap memory.
+// Errors: the constructor throws std::invalid_argument on bad material, degenerate geometry or a
+// failed orientation check; evaluations throw std::domain_error when a state is inadmissible
+// (1 - |q|^2 <= 0 at a node, collapsed current corners) so that an integrator can cut the step.
+#pragma once
+
+#include <Eigen/Core>
+#include <array>
+
+#include "elements/corotational_frame.hpp"
+#include "elements/director.hpp"
+
+namespace shelldyn {
+
+struct ShellMaterial {
+  double E, nu, rho, thickness;
+  double shear_factor = 5.0 / 6.0;
+};
+
+// Switches for tests: mitc = false gives the plain 3x3 displacement element; geometric_stiffness = false
+// drops K_σ. Declared at namespace scope (alias CR9Shell::Options) so that `Options opt = {}` compiles
+// with GCC despite the default member initialisers.
+struct CR9ShellOptions {
+  bool mitc = true;
+  bool geometric_stiffness = true;
+};
+
+class CR9Shell {
+ public:
+  using Vec45 = Eigen::Matrix<double, 45, 1>;
+  using Mat45 = Eigen::Matrix<double, 45, 45>;
+  using Charts = std::array<DirectorChart, 9>;
+  using Options = CR9ShellOptions;
+
+  // X0: initial nodal positions; p0: initial unit nodal normals (averaged by the mesh layer, §2.4).
+  // Throws std::invalid_argument naming the node if e_z0·p_i0 <= 0 (§2.4), if |p_i0| != 1, or if the
+  // element is degenerate; and naming the parameter if the material is invalid.
+  CR9Shell(const std::array<Eigen::Vector3d, 9>& X0, const std::array<Eigen::Vector3d, 9>& p0,
+           const ShellMaterial& mat, Options opt = {});
+
+  // §3.4, §4: F = T^T f_L, K = T^T k_L T + K_σ (exact symmetric Hessian). F, K may be nullptr.
+  // Returns the strain energy U.
+  double internal(const Vec45& u, const Charts& charts, Vec45* F, Mat45* K) const;
+
+  // §6.3 strain-averaged force F*_int,mid = T(u_mid)^T f*_L and its symmetric tangent K_mid (w.r.t.
+  // u_mid; the integrator applies the (1 - alpha_f) chain factor). Returns U(u_np1).
+  double algorithmic_internal(const Vec45& u_n, const Vec45& u_np1, const Charts& charts, double alpha_f,
+                              double xi, Vec45* F, Mat45* K) const;
+
+  void mass(const Vec45& u, const Charts& charts, Mat45* M) const;                        // §5.2
+  void inertial(const Vec45& u, const Vec45& v, const Charts& charts, Vec45* Fm) const;  // §5.2 F_m
+  double kinetic(const Vec45& u, const Vec45& v, const Charts& charts) const;             // §5.1
+  // §5.4 linear and angular momentum about the origin (J includes the director term). Either may be null.
+  void momenta(const Vec45& u, const Vec45& v, const Charts& charts, Eigen::Vector3d* L,
+               Eigen::Vector3d* J) const;
+  double area() const { return area_; }  // reference mid-surface area
+
+  // Diagnostics for tests: local variables u_L = [t_i, θ_i] (absolute θ, §3.2), local force f_L and
+  // local tangent k_L (§4.7) at u. Any pointer may be null. Returns U.
+  double local(const Vec45& u, const Charts& charts, Vec45* uL, Vec45* fL, Mat45* kL) const;
+  // Co-rotational frame at u (gives T via matrix()).
+  CorotationalFrame frame(const Vec45& u, const Charts& charts) const;
+  const Eigen::Matrix<double, 9, 9>& scalar_mass() const { return m_; }  // m_ij = ∫ N_i N_j dA
+
+ private:
+  // Per Gauss point data (§4.5): membrane strain ε_m,c = Lm.row(c)·t + ½ Σ_ij Hm[c](i,j) t_i·t_j.
+  struct GaussPoint {
+    Eigen::Matrix<double, 3, 27> Lm;
+    std::array<Eigen::Matrix<double, 9, 9>, 3> Hm;
+    double dA;
+  };
+  using Mat39 = Eigen::Matrix<double, 3, 9>;
+
+  // Local response of the membrane part with strains from the local translations t1, t0 weighted by
+  // c1, c0 and strain gradient evaluated at tbar (§6.3; internal(): c1 = 1, c0 = 0, tbar = t1).
+  // Adds to fL and kL (t rows only); returns the membrane energy at t1.
+  double membrane(const Mat39& t1, const Mat39& t0, double c1, double c0, const Mat39& tbar, Vec45* fL,
+                  Mat45* kL) const;
+  // Local increments w = [t_i, Δθ_i] of u and the frame at u.
+  CorotationalFrame local_increments(const Vec45& u, const Charts& charts, Vec45* w) const;
+
+  std::array<Eigen::Vector3d, 9> X0_;
+  std::array<Eigen::Vector3d, 9> xl0_;  // initial local coordinates x_i0 (§3.2)
+  std::array<Eigen::Vector2d, 9> th0_;  // θ_i0 = (r_i0,x, r_i0,y)
+  ShellMaterial mat_;
+  Options opt_;
+  Eigen::Matrix3d D1_;                  // plane-stress matrix (§4.6)
+  std::array<GaussPoint, 9> gp_;
+  Mat45 Kbs_;                           // constant bending + shear stiffness Σ dA (B_b^T M + B_s^T Q)
+  Eigen::Matrix<double, 9, 9> m_;
+  double area_ = 0.0;
+};
+
+}  // namespace shelldyn
