@@ -1,0 +1,411 @@
+// Back-ends of lib/linear_solver.hpp. See the header for the contract; the numbers behind the
+// choices (AMD everywhere, supernodal CHOLMOD by default, KLU re-pivot threshold) are in
+// spec/stack.md §§3.2, 5.
+#include "lib/linear_solver.hpp"
+
+#include <Eigen/SparseCholesky>
+#include <cholmod.h>
+#include <klu.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <sstream>
+#include <stdexcept>
+#include <type_traits>
+
+namespace shelldyn {
+
+static_assert(std::is_same<Index, SuiteSparse_long>::value,
+              "shelldyn::Index must equal SuiteSparse_long to hand CSC arrays to klu_l_/cholmod_l_");
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double seconds_since(Clock::time_point t0) {
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
+
+// Values must be finite: a NaN would otherwise travel silently through the factorization.
+void check_values(const CscView& A, const std::string& who) {
+  if (A.values == nullptr) throw std::invalid_argument(who + ": matrix has no value array");
+  const Index nnz = A.nnz();
+  for (Index j = 0; j < A.n; ++j)
+    for (Index p = A.colptr[j]; p < A.colptr[j + 1] && p < nnz; ++p)
+      if (!std::isfinite(A.values[p])) {
+        std::ostringstream os;
+        os << who << ": non-finite matrix entry " << A.values[p] << " at (row " << A.rowind[p]
+           << ", column " << j << "); fix the assembly that produced it";
+        throw std::invalid_argument(os.str());
+      }
+}
+
+// Pattern shape must match the analysed one (cheap O(1) check; the SUNDIALS adapter compares
+// the full arrays).
+void check_same_shape(const CscView& A, Index n, Index nnz, const std::string& who) {
+  if (A.n != n || A.colptr == nullptr || A.nnz() != nnz) {
+    std::ostringstream os;
+    os << who << ": factorize() got a matrix with n = " << A.n << ", nnz = "
+       << (A.colptr ? A.nnz() : 0) << " but the analysed pattern has n = " << n << ", nnz = " << nnz
+       << "; call analyze() again after a pattern change";
+    throw std::invalid_argument(os.str());
+  }
+}
+
+// ------------------------------------------------------------------------------------------------
+// CHOLMOD
+// ------------------------------------------------------------------------------------------------
+class CholmodSolver final : public LinearSolver {
+ public:
+  CholmodSolver() {
+    cholmod_l_start(&cc_);
+    cc_.print = 0;  // report through exceptions, not stderr
+    cc_.nmethods = 1;
+    cc_.method[0].ordering = CHOLMOD_AMD;
+    cc_.postorder = 1;
+    cc_.supernodal = CHOLMOD_SUPERNODAL;
+    cc_.final_ll = 0;
+  }
+  ~CholmodSolver() override {
+    release();
+    cholmod_l_free_dense(&X_, &cc_);
+    cholmod_l_free_dense(&Y_, &cc_);
+    cholmod_l_free_dense(&E_, &cc_);
+    cholmod_l_finish(&cc_);
+  }
+  CholmodSolver(const CholmodSolver&) = delete;
+  CholmodSolver& operator=(const CholmodSolver&) = delete;
+
+  std::string name() const override { return "cholmod"; }
+  bool factorized() const override { return factorized_; }
+
+  void analyze(const CscView& A) override {
+    check_csc_pattern(A, "cholmod");
+    const auto t0 = Clock::now();
+    release();
+    cholmod_sparse S = header(A);
+    L_ = cholmod_l_analyze(&S, &cc_);
+    if (L_ == nullptr || cc_.status < CHOLMOD_OK)
+      throw std::runtime_error("cholmod: cholmod_l_analyze failed (status " +
+                               std::to_string(cc_.status) + ")");
+    n_ = A.n;
+    nnz_ = A.nnz();
+    ++stats_.analyses;
+    stats_.analyze_s += seconds_since(t0);
+  }
+
+  void factorize(const CscView& A) override {
+    if (L_ == nullptr) analyze(A);
+    check_same_shape(A, n_, nnz_, "cholmod");
+    check_values(A, "cholmod");
+    factorized_ = false;
+    const auto t0 = Clock::now();
+    cholmod_sparse S = header(A);
+    cholmod_l_factorize(&S, L_, &cc_);
+    if (cc_.status == CHOLMOD_NOT_POSDEF && !ldlt_) {
+      // Documented fallback: switch to simplicial LDLᵀ for good (header), one re-analysis.
+      ldlt_ = true;
+      cc_.supernodal = CHOLMOD_SIMPLICIAL;
+      cholmod_l_free_factor(&L_, &cc_);
+      stats_.factorize_s += seconds_since(t0);
+      analyze(A);
+      return factorize(A);
+    }
+    stats_.factorize_s += seconds_since(t0);
+    if (cc_.status < CHOLMOD_OK)
+      throw std::runtime_error("cholmod: cholmod_l_factorize failed (status " +
+                               std::to_string(cc_.status) + ", e.g. out of memory)");
+    const char* kind = ldlt_ ? "simplicial LDL^T" : "supernodal LL^T";
+    if (cc_.status == CHOLMOD_NOT_POSDEF) {
+      std::ostringstream os;
+      os << "cholmod (" << kind << "): zero pivot at column " << original_column(L_->minor)
+         << " (matrix singular to working precision; LDL^T does not pivot)";
+      throw std::runtime_error(os.str());
+    }
+    const double rc = cholmod_l_rcond(L_, &cc_);
+    if (!(rc > 0.0) || !std::isfinite(rc)) {
+      std::ostringstream os;
+      os << "cholmod (" << kind << "): numerical breakdown, reciprocal condition estimate " << rc;
+      throw std::runtime_error(os.str());
+    }
+    factorized_ = true;
+    ++stats_.factorizations;
+  }
+
+  void solve(const double* b, double* x) const override {
+    if (!factorized_) throw std::logic_error("cholmod: solve() called without a valid factorization");
+    const auto t0 = Clock::now();
+    cholmod_dense B{};
+    B.nrow = static_cast<size_t>(n_);
+    B.ncol = 1;
+    B.nzmax = B.nrow;
+    B.d = B.nrow;
+    B.x = const_cast<double*>(b);  // read only in cholmod_l_solve2
+    B.xtype = CHOLMOD_REAL;
+    B.dtype = CHOLMOD_DOUBLE;
+    // solve2 reuses X, Y, E across calls: no allocation per solve.
+    if (!cholmod_l_solve2(CHOLMOD_A, L_, &B, nullptr, &X_, nullptr, &Y_, &E_, &cc_))
+      throw std::runtime_error("cholmod: cholmod_l_solve2 failed (status " +
+                               std::to_string(cc_.status) + ")");
+    std::memcpy(x, X_->x, sizeof(double) * static_cast<size_t>(n_));  // alias-safe: X_ is separate
+    ++stats_.solves;
+    stats_.solve_s += seconds_since(t0);
+  }
+
+ private:
+  // Upper triangle of the full storage (stype = +1): entries below the diagonal are ignored.
+  cholmod_sparse header(const CscView& A) const {
+    cholmod_sparse S{};
+    S.nrow = S.ncol = static_cast<size_t>(A.n);
+    S.nzmax = static_cast<size_t>(A.nnz());
+    S.p = const_cast<Index*>(A.colptr);  // CHOLMOD never writes its input matrix
+    S.i = const_cast<Index*>(A.rowind);
+    S.x = const_cast<double*>(A.values);
+    S.stype = 1;
+    S.itype = CHOLMOD_LONG;
+    S.xtype = CHOLMOD_REAL;
+    S.dtype = CHOLMOD_DOUBLE;
+    S.sorted = 1;
+    S.packed = 1;
+    return S;
+  }
+  Index original_column(size_t minor) const {
+    if (L_ && L_->Perm && minor < L_->n) return static_cast<const Index*>(L_->Perm)[minor];
+    return static_cast<Index>(minor);
+  }
+  void release() {
+    if (L_) cholmod_l_free_factor(&L_, &cc_);
+    factorized_ = false;
+  }
+
+  mutable cholmod_common cc_{};
+  cholmod_factor* L_ = nullptr;
+  mutable cholmod_dense *X_ = nullptr, *Y_ = nullptr, *E_ = nullptr;
+  Index n_ = 0, nnz_ = 0;
+  bool ldlt_ = false;
+  bool factorized_ = false;
+};
+
+// ------------------------------------------------------------------------------------------------
+// Eigen SimplicialLDLT on a Map of the caller's arrays (no copy of the pattern on our side).
+// ------------------------------------------------------------------------------------------------
+class EigenLdltSolver final : public LinearSolver {
+  using SpMat = Eigen::SparseMatrix<double, Eigen::ColMajor, Index>;
+  using MapT = Eigen::Map<const SpMat>;
+
+ public:
+  std::string name() const override { return "eigen-ldlt"; }
+  bool factorized() const override { return factorized_; }
+
+  void analyze(const CscView& A) override {
+    check_csc_pattern(A, "eigen-ldlt");
+    const auto t0 = Clock::now();
+    factorized_ = false;
+    ldlt_.analyzePattern(map(A));
+    if (ldlt_.info() != Eigen::Success)
+      throw std::runtime_error("eigen-ldlt: analyzePattern failed");
+    n_ = A.n;
+    nnz_ = A.nnz();
+    analysed_ = true;
+    work_.resize(n_);
+    ++stats_.analyses;
+    stats_.analyze_s += seconds_since(t0);
+  }
+
+  void factorize(const CscView& A) override {
+    if (!analysed_) analyze(A);
+    check_same_shape(A, n_, nnz_, "eigen-ldlt");
+    check_values(A, "eigen-ldlt");
+    factorized_ = false;
+    const auto t0 = Clock::now();
+    ldlt_.factorize(map(A));
+    stats_.factorize_s += seconds_since(t0);
+    const auto& D = ldlt_.vectorD();
+    if (ldlt_.info() != Eigen::Success) {
+      // Eigen stores the failing pivot before stopping: the first zero of D is the column.
+      std::ostringstream os;
+      os << "eigen-ldlt: zero pivot";
+      for (Index k = 0; k < D.size(); ++k)
+        if (D[k] == 0.0) {
+          os << " at column " << ldlt_.permutationPinv().indices()[k];
+          break;
+        }
+      os << " (matrix singular to working precision; LDL^T does not pivot)";
+      throw std::runtime_error(os.str());
+    }
+    if (!D.allFinite())
+      throw std::runtime_error("eigen-ldlt: numerical breakdown (non-finite pivot in D)");
+    factorized_ = true;
+    ++stats_.factorizations;
+  }
+
+  void solve(const double* b, double* x) const override {
+    if (!factorized_)
+      throw std::logic_error("eigen-ldlt: solve() called without a valid factorization");
+    const auto t0 = Clock::now();
+    // Eigen's permuted triangular solves are not alias-safe on Maps; go through work_.
+    work_ = Eigen::Map<const Eigen::VectorXd>(b, n_);
+    Eigen::Map<Eigen::VectorXd>(x, n_) = ldlt_.solve(work_);
+    ++stats_.solves;
+    stats_.solve_s += seconds_since(t0);
+  }
+
+ private:
+  static MapT map(const CscView& A) {
+    return MapT(A.n, A.n, A.nnz(), A.colptr, A.rowind, A.values);
+  }
+  Eigen::SimplicialLDLT<MapT, Eigen::Lower, Eigen::AMDOrdering<Index>> ldlt_;
+  mutable Eigen::VectorXd work_;
+  Index n_ = 0, nnz_ = 0;
+  bool analysed_ = false;
+  bool factorized_ = false;
+};
+
+// ------------------------------------------------------------------------------------------------
+// KLU
+// ------------------------------------------------------------------------------------------------
+class KluSolver final : public LinearSolver {
+ public:
+  KluSolver() {
+    klu_l_defaults(&common_);
+    common_.ordering = 0;  // AMD (stack.md §5.4)
+  }
+  ~KluSolver() override { release(); }
+  KluSolver(const KluSolver&) = delete;
+  KluSolver& operator=(const KluSolver&) = delete;
+
+  std::string name() const override { return "klu"; }
+  bool factorized() const override { return factorized_; }
+
+  void analyze(const CscView& A) override {
+    check_csc_pattern(A, "klu");
+    const auto t0 = Clock::now();
+    release();
+    symbolic_ = klu_l_analyze(A.n, const_cast<Index*>(A.colptr), const_cast<Index*>(A.rowind),
+                              &common_);
+    if (symbolic_ == nullptr)
+      throw std::runtime_error("klu: klu_l_analyze failed (status " +
+                               std::to_string(common_.status) + ")");
+    n_ = A.n;
+    nnz_ = A.nnz();
+    ++stats_.analyses;
+    stats_.analyze_s += seconds_since(t0);
+  }
+
+  void factorize(const CscView& A) override {
+    if (symbolic_ == nullptr) analyze(A);
+    check_same_shape(A, n_, nnz_, "klu");
+    check_values(A, "klu");
+    factorized_ = false;
+    const auto t0 = Clock::now();
+    auto* Ap = const_cast<Index*>(A.colptr);
+    auto* Ai = const_cast<Index*>(A.rowind);
+    auto* Ax = const_cast<double*>(A.values);
+    bool ok = false;
+    if (numeric_ != nullptr) {
+      // Reuse the pivot order; re-pivot if it has become poor (tiny reciprocal pivot growth).
+      ok = klu_l_refactor(Ap, Ai, Ax, symbolic_, numeric_, &common_) &&
+           klu_l_rcond(symbolic_, numeric_, &common_) && common_.rcond >= repivot_threshold();
+    }
+    if (!ok) {
+      if (numeric_) klu_l_free_numeric(&numeric_, &common_);
+      numeric_ = klu_l_factor(Ap, Ai, Ax, symbolic_, &common_);
+      ok = numeric_ != nullptr && klu_l_rcond(symbolic_, numeric_, &common_);
+    }
+    stats_.factorize_s += seconds_since(t0);
+    if (!ok || common_.status != KLU_OK || !(common_.rcond > 0.0) || !std::isfinite(common_.rcond)) {
+      std::ostringstream os;
+      os << "klu: ";
+      if (common_.status == KLU_SINGULAR)
+        os << "matrix is singular (zero pivot at column " << common_.singular_col << ")";
+      else if (common_.status < 0)
+        os << "klu_l_factor failed (status " << common_.status << ")";
+      else
+        os << "numerical breakdown (reciprocal pivot growth estimate " << common_.rcond << ")";
+      if (numeric_) klu_l_free_numeric(&numeric_, &common_);
+      throw std::runtime_error(os.str());
+    }
+    factorized_ = true;
+    ++stats_.factorizations;
+  }
+
+  void solve(const double* b, double* x) const override {
+    if (!factorized_) throw std::logic_error("klu: solve() called without a valid factorization");
+    const auto t0 = Clock::now();
+    if (x != b) std::memcpy(x, b, sizeof(double) * static_cast<size_t>(n_));
+    if (!klu_l_solve(symbolic_, numeric_, n_, 1, x, &common_))
+      throw std::runtime_error("klu: klu_l_solve failed (status " + std::to_string(common_.status) +
+                               ")");
+    ++stats_.solves;
+    stats_.solve_s += seconds_since(t0);
+  }
+
+ private:
+  // eps^(2/3) ≈ 3.7e-11, SUNDIALS' own threshold for a fresh factorization.
+  static double repivot_threshold() {
+    return std::pow(std::numeric_limits<double>::epsilon(), 2.0 / 3.0);
+  }
+  void release() {
+    if (numeric_) klu_l_free_numeric(&numeric_, &common_);
+    if (symbolic_) klu_l_free_symbolic(&symbolic_, &common_);
+    factorized_ = false;
+  }
+
+  mutable klu_l_common common_{};
+  klu_l_symbolic* symbolic_ = nullptr;
+  klu_l_numeric* numeric_ = nullptr;
+  Index n_ = 0, nnz_ = 0;
+  bool factorized_ = false;
+};
+
+}  // namespace
+
+void check_csc_pattern(const CscView& A, const std::string& who) {
+  std::ostringstream os;
+  os << who << ": invalid CSC pattern: ";
+  if (A.n <= 0 || A.colptr == nullptr) {
+    os << "empty matrix (n = " << A.n << ")";
+    throw std::invalid_argument(os.str());
+  }
+  if (A.colptr[0] != 0) {
+    os << "colptr[0] = " << A.colptr[0] << " (must be 0)";
+    throw std::invalid_argument(os.str());
+  }
+  if (A.nnz() > 0 && A.rowind == nullptr) {
+    os << "row index array missing";
+    throw std::invalid_argument(os.str());
+  }
+  for (Index j = 0; j < A.n; ++j) {
+    if (A.colptr[j + 1] < A.colptr[j]) {
+      os << "colptr decreases at column " << j;
+      throw std::invalid_argument(os.str());
+    }
+    for (Index p = A.colptr[j]; p < A.colptr[j + 1]; ++p) {
+      const Index i = A.rowind[p];
+      if (i < 0 || i >= A.n) {
+        os << "row index " << i << " out of range [0, " << A.n << ") in column " << j;
+        throw std::invalid_argument(os.str());
+      }
+      if (p > A.colptr[j] && i <= A.rowind[p - 1]) {
+        os << "row indices not strictly increasing in column " << j << " (row " << i
+           << " after row " << A.rowind[p - 1] << "); sort and remove duplicates";
+        throw std::invalid_argument(os.str());
+      }
+    }
+  }
+}
+
+std::vector<std::string> linear_solver_names() { return {"cholmod", "eigen-ldlt", "klu"}; }
+
+std::unique_ptr<LinearSolver> make_linear_solver(const std::string& name) {
+  if (name == "cholmod") return std::make_unique<CholmodSolver>();
+  if (name == "eigen-ldlt") return std::make_unique<EigenLdltSolver>();
+  if (name == "klu") return std::make_unique<KluSolver>();
+  std::string valid;
+  for (const auto& n : linear_solver_names()) valid += (valid.empty() ? "" : ", ") + n;
+  throw std::invalid_argument("unknown linear solver '" + name + "'; valid names: " + valid);
+}
+
+}  // namespace shelldyn

@@ -1,0 +1,87 @@
+// Sparse direct solvers for the symmetric systems of the project (tangents K̄, mass matrices, IDA and
+// ARKODE iteration matrices), behind one small interface: analyse once per pattern, factorize per
+// Newton setup, solve per iteration (architecture.md §4.4, spec/stack.md §5).
+//
+// Input contract (lib/sparse_matrix.hpp): square CSC with 64-bit indices, FULL storage (both
+// triangles), row indices sorted within each column, no duplicates. Each back-end reads what it
+// needs directly from that storage, without copying the pattern. "cholmod" and "eigen-ldlt" read
+// one triangle and therefore assume symmetric values; "klu" factors the full storage and also
+// works for non-symmetric matrices (e.g. IDA/ARKODE iteration matrices of first-order systems).
+//   - "cholmod":    CHOLMOD (cholmod_l_*), upper triangle (stype = +1), AMD ordering, supernodal LLᵀ.
+//                   If the matrix is not positive definite (CHOLMOD_NOT_POSDEF), the solver switches
+//                   PERMANENTLY to simplicial LDLᵀ (re-analysis once; visible as an extra count in
+//                   stats().analyses) and retries. Rationale: a tangent that was indefinite once
+//                   (buckling, snap-through) tends to stay near-indefinite, and flip-flopping would
+//                   re-analyse every time. LDLᵀ has no pivoting (stack.md §5.3): a zero pivot or a
+//                   non-finite factor throws. Supernodal speed depends on BLAS; with OpenBLAS set
+//                   OPENBLAS_NUM_THREADS=1 on small shared machines (stack.md §1.1).
+//   - "eigen-ldlt": Eigen::SimplicialLDLT on an Eigen::Map of the arrays, lower triangle, AMD.
+//                   LDLᵀ without pivoting: works on mildly indefinite matrices, throws on breakdown.
+//   - "klu":        KLU (klu_l_*), LU with partial pivoting, AMD ordering (ordering = 0, never the
+//                   COLAMD default, stack.md §5.4). First factorization klu_l_factor, then
+//                   klu_l_refactor (reuses the pivot order); when the reciprocal pivot growth
+//                   estimate klu_l_rcond drops below eps^(2/3) a fresh klu_l_factor re-pivots
+//                   (same threshold as SUNDIALS' own KLU module, stack.md §3.2). Handles indefinite
+//                   matrices; slower than the other two on shell patterns.
+//
+// Errors: bad input (wrong size, unsorted pattern, non-finite values, pattern different from the
+// analysed one) -> std::invalid_argument; singular / not positive definite / breakdown ->
+// std::runtime_error naming the back-end, the reason and the column where the library reports one.
+// After a failed factorize() the solver has no valid factorization: solve() throws until the next
+// successful factorize().
+//
+// Not thread-safe: solve() is const but uses internal work buffers and updates stats().
+#pragma once
+
+#include "lib/sparse_matrix.hpp"
+
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace shelldyn {
+
+class LinearSolver {
+ public:
+  virtual ~LinearSolver() = default;
+
+  // Registered name ("cholmod", "eigen-ldlt", "klu").
+  virtual std::string name() const = 0;
+
+  // Fill-reducing ordering + symbolic analysis. Call once per pattern; calling it again with a
+  // new pattern is allowed (e.g. after remeshing) and discards the previous factorization.
+  virtual void analyze(const CscView& A) = 0;
+
+  // Numeric factorization of A on the analysed pattern (same n and nnz; the caller guarantees the
+  // same colptr/rowind, the SUNDIALS adapter checks it). Analyses first if analyze() was never
+  // called.
+  virtual void factorize(const CscView& A) = 0;
+
+  // x = A⁻¹ b with the last factorization; b and x have length n. x may alias b (x == b gives an
+  // in-place solve); partial overlap is not allowed.
+  virtual void solve(const double* b, double* x) const = 0;
+
+  // True after a successful factorize() (and until the next analyze() or failed factorize()).
+  virtual bool factorized() const = 0;
+
+  // Counters and process-independent wall times (std::chrono::steady_clock) in seconds.
+  struct Stats {
+    long analyses = 0, factorizations = 0, solves = 0;
+    double analyze_s = 0, factorize_s = 0, solve_s = 0;
+  };
+  const Stats& stats() const { return stats_; }
+
+ protected:
+  mutable Stats stats_;
+};
+
+// "cholmod" | "eigen-ldlt" | "klu"; anything else throws std::invalid_argument listing valid names.
+std::unique_ptr<LinearSolver> make_linear_solver(const std::string& name);
+std::vector<std::string> linear_solver_names();
+
+// Structural checks shared by the back-ends (and useful to callers): n > 0, colptr[0] == 0,
+// non-decreasing colptr, row indices in [0, n) and strictly increasing within each column.
+// Throws std::invalid_argument naming `who`, the column and the problem.
+void check_csc_pattern(const CscView& A, const std::string& who);
+
+}  // namespace shelldyn

@@ -1,0 +1,238 @@
+// Sparse direct solver back-ends (lib/linear_solver.hpp) on a 9-node-shell-like pattern:
+// ne x ne quadratic quads, (2ne+1)^2 nodes, 5 DOF per node, every element couples its 45 DOFs
+// (spec/stack.md §5.1). Values: per element a random SPD block B Bᵀ/45 + 0.01 I, so the assembled
+// matrix is SPD; an indefinite variant shifts the diagonal.
+#include "lib/linear_solver.hpp"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Sparse>
+
+#include <algorithm>
+#include <cmath>
+#include <memory>
+#include <random>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace shelldyn {
+namespace {
+
+// Assembles the shell-like test matrix in full symmetric CSC storage (sorted, no duplicates).
+SparseMatrix shell_like_matrix(int ne, unsigned seed, double diagonal_shift = 0.0) {
+  const int nn = 2 * ne + 1;
+  const Index n = Index(nn) * nn * 5;
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> normal;
+  std::vector<Eigen::Triplet<double, Index>> trip;
+  for (int ey = 0; ey < ne; ++ey)
+    for (int ex = 0; ex < ne; ++ex) {
+      std::vector<Index> dofs;
+      for (int a = 0; a < 3; ++a)
+        for (int b = 0; b < 3; ++b)
+          for (int c = 0; c < 5; ++c) dofs.push_back((Index(2 * ey + a) * nn + (2 * ex + b)) * 5 + c);
+      Eigen::MatrixXd B(45, 45);
+      for (int i = 0; i < 45; ++i)
+        for (int j = 0; j < 45; ++j) B(i, j) = normal(rng);
+      const Eigen::MatrixXd Ke = B * B.transpose() / 45.0 + 0.01 * Eigen::MatrixXd::Identity(45, 45);
+      for (int i = 0; i < 45; ++i)
+        for (int j = 0; j < 45; ++j) trip.emplace_back(dofs[i], dofs[j], Ke(i, j));
+    }
+  for (Index i = 0; i < n; ++i) trip.emplace_back(i, i, diagonal_shift);
+  Eigen::SparseMatrix<double, Eigen::ColMajor, Index> A(n, n);
+  A.setFromTriplets(trip.begin(), trip.end());
+  A.makeCompressed();
+  auto pattern = std::make_shared<SparsePattern>();
+  pattern->n = n;
+  pattern->colptr.assign(A.outerIndexPtr(), A.outerIndexPtr() + n + 1);
+  pattern->rowind.assign(A.innerIndexPtr(), A.innerIndexPtr() + A.nonZeros());
+  SparseMatrix M;
+  M.pattern = pattern;
+  M.values.assign(A.valuePtr(), A.valuePtr() + A.nonZeros());
+  return M;
+}
+
+// ‖A x − b‖₂ / ‖b‖₂ using the full storage.
+double relative_residual(const CscView& A, const std::vector<double>& x, const std::vector<double>& b) {
+  std::vector<double> r(b.begin(), b.end());
+  for (Index j = 0; j < A.n; ++j)
+    for (Index p = A.colptr[j]; p < A.colptr[j + 1]; ++p) r[A.rowind[p]] -= A.values[p] * x[j];
+  double rr = 0, bb = 0;
+  for (size_t i = 0; i < b.size(); ++i) rr += r[i] * r[i], bb += b[i] * b[i];
+  return std::sqrt(rr / bb);
+}
+
+std::vector<double> random_vector(Index n, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(-1, 1);
+  std::vector<double> v(n);
+  for (auto& x : v) x = u(rng);
+  return v;
+}
+
+TEST(LinearSolver, FactoryListsNamesAndRejectsUnknown) {
+  const auto names = linear_solver_names();
+  ASSERT_EQ(names.size(), 3u);
+  for (const auto& n : names) EXPECT_EQ(make_linear_solver(n)->name(), n);
+  try {
+    make_linear_solver("umfpack");
+    FAIL() << "expected std::invalid_argument";
+  } catch (const std::invalid_argument& e) {
+    const std::string msg = e.what();
+    EXPECT_NE(msg.find("umfpack"), std::string::npos) << msg;
+    for (const auto& n : names) EXPECT_NE(msg.find(n), std::string::npos) << msg;
+  }
+}
+
+TEST(LinearSolver, AllBackEndsSolveSpdShellPatternAndAgree) {
+  const SparseMatrix A = shell_like_matrix(4, 1);  // 9x9 nodes, 405 DOFs
+  const auto b = random_vector(A.pattern->n, 2);
+  std::vector<std::vector<double>> solutions;
+  for (const auto& name : linear_solver_names()) {
+    auto s = make_linear_solver(name);
+    s->analyze(A.view());
+    s->factorize(A.view());
+    std::vector<double> x(b.size());
+    s->solve(b.data(), x.data());
+    const double res = relative_residual(A.view(), x, b);
+    EXPECT_LT(res, 1e-12) << name;
+    RecordProperty(name + "_relres", std::to_string(res));
+    solutions.push_back(x);
+  }
+  for (size_t k = 1; k < solutions.size(); ++k) {
+    double diff = 0, ref = 0;
+    for (size_t i = 0; i < b.size(); ++i) {
+      diff = std::max(diff, std::abs(solutions[k][i] - solutions[0][i]));
+      ref = std::max(ref, std::abs(solutions[0][i]));
+    }
+    EXPECT_LT(diff / ref, 1e-10) << linear_solver_names()[k] << " vs " << linear_solver_names()[0];
+  }
+}
+
+TEST(LinearSolver, InPlaceSolveWhenXAliasesB) {
+  const SparseMatrix A = shell_like_matrix(2, 3);
+  const auto b = random_vector(A.pattern->n, 4);
+  for (const auto& name : linear_solver_names()) {
+    auto s = make_linear_solver(name);
+    s->factorize(A.view());
+    std::vector<double> x = b;
+    s->solve(x.data(), x.data());
+    EXPECT_LT(relative_residual(A.view(), x, b), 1e-12) << name;
+  }
+}
+
+TEST(LinearSolver, AnalysisOnceAcrossSeveralFactorizations) {
+  SparseMatrix A = shell_like_matrix(3, 5);
+  const std::vector<double> base = A.values;
+  const auto b = random_vector(A.pattern->n, 6);
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(-1e-3, 1e-3);
+  for (const auto& name : linear_solver_names()) {
+    auto s = make_linear_solver(name);
+    for (int k = 0; k < 4; ++k) {
+      // New values on the same pattern (symmetric perturbation of the off-diagonals keeps SPD).
+      A.values = base;
+      const auto& P = *A.pattern;
+      for (Index j = 0; j < P.n; ++j)
+        for (Index p = P.colptr[j]; p < P.colptr[j + 1]; ++p)
+          if (P.rowind[p] == j) A.values[p] *= 1.0 + u(rng);
+      s->factorize(A.view());  // first call analyses implicitly
+      std::vector<double> x(b.size());
+      s->solve(b.data(), x.data());
+      s->solve(b.data(), x.data());
+      EXPECT_LT(relative_residual(A.view(), x, b), 1e-12) << name << " factorization " << k;
+    }
+    EXPECT_EQ(s->stats().analyses, 1) << name;
+    EXPECT_EQ(s->stats().factorizations, 4) << name;
+    EXPECT_EQ(s->stats().solves, 8) << name;
+    EXPECT_GT(s->stats().factorize_s, 0.0) << name;
+  }
+}
+
+// Documented behaviour: supernodal LLᵀ hits CHOLMOD_NOT_POSDEF, the solver switches to simplicial
+// LDLᵀ for good (one extra analysis) and solves; later factorizations stay on LDLᵀ (no new analysis).
+TEST(LinearSolver, CholmodFallsBackToLdltOnIndefiniteMatrix) {
+  const SparseMatrix A = shell_like_matrix(3, 8, -0.5);
+  const auto b = random_vector(A.pattern->n, 9);
+  auto s = make_linear_solver("cholmod");
+  s->analyze(A.view());
+  s->factorize(A.view());
+  EXPECT_EQ(s->stats().analyses, 2);
+  std::vector<double> x(b.size());
+  s->solve(b.data(), x.data());
+  EXPECT_LT(relative_residual(A.view(), x, b), 1e-9);
+  s->factorize(A.view());
+  EXPECT_EQ(s->stats().analyses, 2);
+  EXPECT_EQ(s->stats().factorizations, 2);
+  // The matrix really is indefinite: Eigen's LDLᵀ must agree, KLU too.
+  for (const char* other : {"eigen-ldlt", "klu"}) {
+    auto o = make_linear_solver(other);
+    o->factorize(A.view());
+    std::vector<double> y(b.size());
+    o->solve(b.data(), y.data());
+    EXPECT_LT(relative_residual(A.view(), y, b), 1e-9) << other;
+  }
+}
+
+TEST(LinearSolver, SpdMatrixKeepsCholmodSupernodal) {
+  const SparseMatrix A = shell_like_matrix(3, 10);
+  auto s = make_linear_solver("cholmod");
+  s->factorize(A.view());
+  EXPECT_EQ(s->stats().analyses, 1);  // no fallback re-analysis
+}
+
+// A singular matrix (a zero row/column) must throw naming the back-end and the column.
+TEST(LinearSolver, SingularMatrixThrowsNamingBackEndAndColumn) {
+  SparseMatrix A = shell_like_matrix(2, 11);
+  const auto& P = *A.pattern;
+  const Index dead = 17;
+  for (Index j = 0; j < P.n; ++j)
+    for (Index p = P.colptr[j]; p < P.colptr[j + 1]; ++p)
+      if (j == dead || P.rowind[p] == dead) A.values[p] = 0.0;
+  for (const auto& name : linear_solver_names()) {
+    auto s = make_linear_solver(name);
+    try {
+      s->factorize(A.view());
+      FAIL() << name << ": expected std::runtime_error";
+    } catch (const std::runtime_error& e) {
+      const std::string msg = e.what();
+      EXPECT_EQ(msg.rfind(name, 0), 0u) << msg;
+      EXPECT_NE(msg.find("column"), std::string::npos) << msg;
+      if (name != "klu") {  // KLU reports the column in its own (BTF/AMD-permuted) numbering
+        EXPECT_NE(msg.find("column 17"), std::string::npos) << msg;
+      }
+    }
+    EXPECT_FALSE(s->factorized());
+    std::vector<double> x(P.n, 1.0);
+    EXPECT_THROW(s->solve(x.data(), x.data()), std::logic_error) << name;
+  }
+}
+
+TEST(LinearSolver, BadInputIsRejectedWithAClearMessage) {
+  SparseMatrix A = shell_like_matrix(1, 12);
+  for (const auto& name : linear_solver_names()) {
+    auto s = make_linear_solver(name);
+    // Non-finite value.
+    SparseMatrix B = A;
+    B.values[5] = std::nan("");
+    EXPECT_THROW(s->factorize(B.view()), std::invalid_argument) << name;
+    // Unsorted rows.
+    auto bad = std::make_shared<SparsePattern>(*A.pattern);
+    std::swap(bad->rowind[0], bad->rowind[1]);
+    SparseMatrix C{bad, A.values};
+    try {
+      s->analyze(C.view());
+      FAIL() << name;
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find("column 0"), std::string::npos) << e.what();
+    }
+    // Pattern of another size after analysis.
+    s->analyze(A.view());
+    const SparseMatrix D = shell_like_matrix(2, 13);
+    EXPECT_THROW(s->factorize(D.view()), std::invalid_argument) << name;
+  }
+}
+
+}  // namespace
+}  // namespace shelldyn
