@@ -95,8 +95,9 @@ std::vector<Vec3> initial_normals(const Mesh& mesh) {
     // Unit vectors that cancel to well below 1 per contributor mean opposite element orientations.
     if (!(len > 1e-8 * count[i]))
       throw std::invalid_argument("initial_normals: the element normals at mesh node " + std::to_string(i) +
-                                  " cancel; adjacent elements are oriented oppositely; call "
-                                  "orient_consistently() first");
+                                  " cancel: adjacent elements are oriented oppositely (call "
+                                  "orient_consistently() first) or the mesh is folded there (out of "
+                                  "scope, spec/element.md §2.4)");
     sum[i] /= len;  // spec §2.4 step 2
   }
   return sum;
