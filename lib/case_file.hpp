@@ -1,0 +1,188 @@
+// Case files (YAML): the user-facing description of one simulation (architecture.md §5).
+//
+// load_case() parses and validates a case file into a CaseSpec, a plain value that holds what the
+// file says, resolved only as far as possible without building the mesh (paths made absolute,
+// defaults filled in). Everything that needs the mesh (set look-up, load distribution, initial
+// velocity) happens in build_discretization() (lib/discretization.hpp), which reports errors with
+// the same "FILE:LINE: key.path" prefix kept in the `where` fields below.
+//
+// Schema (every key is checked; unknown keys, wrong types, missing required keys, non-positive sizes,
+// empty lists and bad names are errors):
+//
+//   name: flying-plate                 optional, default = file stem
+//   description: "..."                 optional
+//   mesh:                              exactly one of `generator` / `file`
+//     generator: rectangle             a, b, nx, ny, [x0, y0]
+//              | cell_union            cells: [[i0,j0,i1,j1], ...], [cell]
+//              | cylindrical_panel     radius, angle, length, n_arc, n_axial
+//              | hemisphere            radius, hole_deg, quarter, n
+//     file: plate.msh                  Gmsh 4.1 (quad9); relative to the case file's folder
+//   material: {E, nu, rho, thickness, [shear_factor = 5/6]}
+//   sets:                              optional extra node sets, each exactly one of
+//     NAME: {point: [x,y,z], [tol]} | {box: [[xmin,ymin,zmin],[xmax,ymax,zmax]]}
+//         | {nodes: [i, ...]}  (0-based) | {union: [NAME, ...]}
+//   boundary_conditions: [{set, fix: [ux|uy|uz|px|py|pz|director, ...]}, ...]          optional
+//   initial_velocity: {[translation], [angular], [about: centroid | [x,y,z]]}             optional
+//   loads: [{set, type: force|moment, direction, amplitude, [distribution: per_node|edge_total],
+//            [function: {type: constant|ramp|hat|triangle|table, ...}]}, ...]           optional
+//   integrator: {name, ...settings}    settings kept as ordered (key, scalar text) pairs
+//   time: {dt, t_end, [output_interval = dt]}
+//   output: {[vtu = true], [vtu_every = 10], [history = true]}                           optional
+//   monitors: [{name, set, quantity: ux|uy|uz|ur|px|py|pz|vx|vy|vz}, ...]                 optional
+//
+// Errors: std::runtime_error with one line "FILE:LINE: key.path: reason (how to fix)".
+// Units: whatever consistent system the file uses; nothing is scaled.
+#pragma once
+
+#include "lib/dof_map.hpp"
+#include "lib/time_function.hpp"
+
+#include <Eigen/Core>
+#include <array>
+#include <string>
+#include <utility>
+#include <variant>
+#include <vector>
+
+namespace shelldyn {
+
+// --- mesh ----------------------------------------------------------------------------------------
+// Parameter names are those of lib/mesh_generators.hpp.
+struct RectangleMeshSpec {
+  double a = 0, b = 0;
+  int nx = 0, ny = 0;
+  double x0 = 0, y0 = 0;
+};
+struct CellUnionMeshSpec {
+  std::vector<std::array<int, 4>> cells;
+  double cell = 1.0;
+};
+struct CylindricalPanelMeshSpec {
+  double radius = 0, angle = 0, length = 0;
+  int n_arc = 0, n_axial = 0;
+};
+struct HemisphereMeshSpec {
+  double radius = 0, hole_deg = 0;
+  bool quarter = false;
+  int n = 0;
+};
+struct MeshFileSpec {
+  std::string path;  // absolute (resolved against the case file's folder)
+};
+using MeshSpec =
+    std::variant<RectangleMeshSpec, CellUnionMeshSpec, CylindricalPanelMeshSpec, HemisphereMeshSpec, MeshFileSpec>;
+
+// "rectangle", "cell_union", "cylindrical_panel", "hemisphere" or "file".
+const char* mesh_kind_name(const MeshSpec& mesh);
+
+// --- material ------------------------------------------------------------------------------------
+// Kept separate from the element's material type on purpose: the case file is the user's vocabulary.
+struct CaseMaterial {
+  double E = 0;             // Young's modulus
+  double nu = 0;            // Poisson ratio, -1 < nu < 0.5
+  double rho = 0;           // mass density per volume
+  double thickness = 0;     // shell thickness h
+  double shear_factor = 5.0 / 6.0;
+};
+
+// --- node sets defined in the case file ----------------------------------------------------------
+struct SetSpec {
+  enum class Kind { Point, Box, Nodes, Union };
+  std::string name;
+  Kind kind = Kind::Nodes;
+  Eigen::Vector3d point = Eigen::Vector3d::Zero();  // Point
+  double tol = -1.0;                                 // Point; < 0: default 1e-6 * mesh size
+  Eigen::Vector3d box_min = Eigen::Vector3d::Zero(), box_max = Eigen::Vector3d::Zero();  // Box
+  std::vector<int> nodes;                            // Nodes (0-based, as written)
+  std::vector<std::string> members;                  // Union
+  std::string where;                                 // "FILE:LINE: sets.NAME" for later errors
+};
+
+struct BoundaryConditionSpec {
+  std::string set;
+  std::vector<Fix> fix;
+  std::string where;  // "FILE:LINE: boundary_conditions[k]"
+};
+
+struct InitialVelocitySpec {
+  bool given = false;  // false: the body starts at rest
+  Eigen::Vector3d translation = Eigen::Vector3d::Zero();
+  Eigen::Vector3d angular = Eigen::Vector3d::Zero();
+  bool about_centroid = true;  // true: about = centroid of the nodes
+  Eigen::Vector3d about = Eigen::Vector3d::Zero();
+  std::string where;
+};
+
+enum class LoadType { Force, Moment };
+enum class LoadDistribution { PerNode, EdgeTotal };
+const char* load_type_name(LoadType t);
+const char* load_distribution_name(LoadDistribution d);
+
+struct LoadSpec {
+  std::string set;
+  LoadType type = LoadType::Force;
+  Eigen::Vector3d direction = Eigen::Vector3d::Zero();  // not normalised: the load is amplitude * direction
+  double amplitude = 0;
+  LoadDistribution distribution = LoadDistribution::PerNode;
+  TimeFunction function;  // default constant
+  std::string where;      // "FILE:LINE: loads[k]"
+};
+
+struct IntegratorSpec {
+  std::string name;
+  std::vector<std::pair<std::string, std::string>> settings;  // in file order, values as written
+};
+
+struct TimeSpec {
+  double dt = 0;
+  double t_end = 0;
+  double output_interval = 0;
+  // Number of steps to reach t_end: round(t_end/dt) if t_end is a multiple of dt up to 1e-9
+  // relative, else ceil(t_end/dt) (the last step is then shortened by the caller or overshoots).
+  long long num_steps() const;
+};
+
+struct OutputSpec {
+  bool vtu = true;
+  int vtu_every = 10;  // write a VTU every this many output steps
+  bool history = true;
+};
+
+enum class MonitorQuantity { Ux, Uy, Uz, Ur, Px, Py, Pz, Vx, Vy, Vz };
+const char* monitor_quantity_name(MonitorQuantity q);
+
+struct MonitorSpec {
+  std::string name;
+  std::string set;  // must resolve to exactly one node
+  MonitorQuantity quantity = MonitorQuantity::Ux;
+  std::string where;
+};
+
+struct CaseSpec {
+  std::string name;
+  std::string description;
+  std::string source;    // the case file path as given (or the label passed to load_case_from_string)
+  std::string base_dir;  // folder that relative paths in the file are resolved against
+  MeshSpec mesh;
+  std::string mesh_where;
+  CaseMaterial material;
+  std::vector<SetSpec> sets;
+  std::vector<BoundaryConditionSpec> boundary_conditions;
+  InitialVelocitySpec initial_velocity;
+  std::vector<LoadSpec> loads;
+  IntegratorSpec integrator;
+  TimeSpec time;
+  OutputSpec output;
+  std::vector<MonitorSpec> monitors;
+};
+
+// Reads and validates a case file. Throws std::runtime_error ("FILE:LINE: key.path: reason") on
+// any problem, including an unreadable file or YAML syntax errors.
+CaseSpec load_case(const std::string& path);
+
+// Same from text (tests, embedded cases). `source` labels error messages and gives the default name
+// (its stem); relative mesh paths are resolved against `base_dir`.
+CaseSpec load_case_from_string(const std::string& text, const std::string& source,
+                               const std::string& base_dir = ".");
+
+}  // namespace shelldyn

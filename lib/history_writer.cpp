@@ -1,0 +1,59 @@
+#include "lib/history_writer.hpp"
+
+#include <cerrno>
+#include <cstring>
+#include <set>
+#include <stdexcept>
+
+namespace shelldyn {
+
+const std::vector<std::string>& history_standard_columns() {
+  static const std::vector<std::string> cols = {
+      "step", "t",  "dt", "kinetic", "strain", "external_work", "total",           "rel_drift",     "Lx",
+      "Ly",   "Lz", "Jx", "Jy",      "Jz",     "nonlinear_iters", "linear_setups", "wall_s"};
+  return cols;
+}
+
+HistoryWriter::HistoryWriter(const std::string& path, std::vector<std::string> extra_columns,
+                             std::vector<std::string> monitor_columns)
+    : path_(path), num_extra_(extra_columns.size()), num_monitors_(monitor_columns.size()) {
+  columns_ = history_standard_columns();
+  columns_.insert(columns_.end(), extra_columns.begin(), extra_columns.end());
+  columns_.insert(columns_.end(), monitor_columns.begin(), monitor_columns.end());
+  std::set<std::string> seen;
+  for (const auto& c : columns_) {
+    if (c.empty() || c.find_first_of(",\"\r\n") != std::string::npos)
+      throw std::invalid_argument("history.csv: invalid column name '" + c +
+                                  "' (must be non-empty, without commas, quotes or line breaks)");
+    if (!seen.insert(c).second)
+      throw std::invalid_argument("history.csv: column '" + c + "' appears twice (rename the monitor or extra column)");
+  }
+  file_ = std::fopen(path.c_str(), "w");
+  if (!file_) throw std::runtime_error(path + ": cannot create history file: " + std::strerror(errno));
+  for (size_t k = 0; k < columns_.size(); ++k) std::fprintf(file_, "%s%s", k ? "," : "", columns_[k].c_str());
+  std::fputc('\n', file_);
+  std::fflush(file_);
+}
+
+HistoryWriter::~HistoryWriter() {
+  if (file_) std::fclose(file_);
+}
+
+void HistoryWriter::write(const HistoryRow& r) {
+  if (r.extra.size() != num_extra_ || r.monitors.size() != num_monitors_)
+    throw std::invalid_argument("history.csv: row has " + std::to_string(r.extra.size()) + " extra and " +
+                                std::to_string(r.monitors.size()) + " monitor values, header expects " +
+                                std::to_string(num_extra_) + " and " + std::to_string(num_monitors_));
+  std::fprintf(file_, "%lld", r.step);
+  const double reals[] = {r.t, r.dt, r.kinetic, r.strain, r.external_work, r.total, r.rel_drift,
+                          r.L.x(), r.L.y(), r.L.z(), r.J.x(), r.J.y(), r.J.z()};
+  for (double v : reals) std::fprintf(file_, ",%.17g", v);
+  std::fprintf(file_, ",%lld,%lld,%.17g", r.nonlinear_iters, r.linear_setups, r.wall_s);
+  for (double v : r.extra) std::fprintf(file_, ",%.17g", v);
+  for (double v : r.monitors) std::fprintf(file_, ",%.17g", v);
+  std::fputc('\n', file_);
+  if (std::fflush(file_) != 0 || std::ferror(file_))
+    throw std::runtime_error(path_ + ": write error: " + std::strerror(errno));
+}
+
+}  // namespace shelldyn

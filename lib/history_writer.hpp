@@ -1,0 +1,57 @@
+// history.csv: one row per output step (architecture.md §5), for tools and plots.
+//
+// Columns, in order: the standard columns of history_standard_columns(), then the caller's extra
+// columns (integrator-specific counters), then one column per monitor. Values are written with
+// %.17g (round-trip exact); integer counters as integers. Each row is flushed, so a crashed or
+// interrupted run leaves a readable file.
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+namespace shelldyn {
+
+// step,t,dt,kinetic,strain,external_work,total,rel_drift,Lx,Ly,Lz,Jx,Jy,Jz,nonlinear_iters,
+// linear_setups,wall_s
+const std::vector<std::string>& history_standard_columns();
+
+struct HistoryRow {
+  long long step = 0;
+  double t = 0, dt = 0;
+  double kinetic = 0, strain = 0, external_work = 0, total = 0, rel_drift = 0;
+  Eigen::Vector3d L = Eigen::Vector3d::Zero();  // linear momentum (element.md §5.4)
+  Eigen::Vector3d J = Eigen::Vector3d::Zero();  // angular momentum about the origin, director term included
+  long long nonlinear_iters = 0, linear_setups = 0;
+  double wall_s = 0;
+  std::vector<double> extra;     // one per extra column, in order
+  std::vector<double> monitors;  // one per monitor column, in order
+};
+
+class HistoryWriter {
+ public:
+  // Creates (truncates) `path` and writes the header. Throws std::runtime_error if the file cannot be
+  // opened, std::invalid_argument if a column name is empty, contains ',', '"' or a line break, or
+  // repeats another column.
+  HistoryWriter(const std::string& path, std::vector<std::string> extra_columns,
+                std::vector<std::string> monitor_columns);
+  ~HistoryWriter();
+  HistoryWriter(const HistoryWriter&) = delete;
+  HistoryWriter& operator=(const HistoryWriter&) = delete;
+
+  // Appends one row and flushes. Throws std::invalid_argument if the numbers of extra or monitor
+  // values do not match the header, std::runtime_error on a write error.
+  void write(const HistoryRow& row);
+
+  const std::vector<std::string>& columns() const { return columns_; }
+  const std::string& path() const { return path_; }
+
+ private:
+  std::string path_;
+  std::FILE* file_ = nullptr;
+  size_t num_extra_ = 0, num_monitors_ = 0;
+  std::vector<std::string> columns_;
+};
+
+}  // namespace shelldyn

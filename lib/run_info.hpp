@@ -1,0 +1,61 @@
+// run.json: makes a result folder explain itself (architecture.md §5) — the resolved case settings,
+// the software versions, the run status and a summary of key numbers.
+//
+// The JSON is written by hand (no JSON dependency); strings are escaped per RFC 8259 and non-finite
+// numbers become null (JSON has no NaN/inf).
+#pragma once
+
+#include "lib/case_file.hpp"
+
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace shelldyn {
+
+// Version of this library (the SHELLDYN_VERSION compile definition of shelldyn_core).
+std::string shelldyn_version();
+// "3.4.0": from Eigen's version macros.
+std::string eigen_version();
+
+// Ordered key/value pairs with JSON scalar values. Keys keep insertion order; setting an existing
+// key replaces its value in place.
+class JsonFields {
+ public:
+  void set(const std::string& key, const std::string& value);
+  void set(const std::string& key, const char* value) { set(key, std::string(value)); }
+  void set(const std::string& key, double value);
+  void set(const std::string& key, int value) { set(key, static_cast<long long>(value)); }
+  void set(const std::string& key, long value) { set(key, static_cast<long long>(value)); }
+  void set(const std::string& key, long long value);
+  void set(const std::string& key, bool value);
+  // Each entry is (key, already-encoded JSON value).
+  const std::vector<std::pair<std::string, std::string>>& entries() const { return entries_; }
+  bool empty() const { return entries_.empty(); }
+
+ private:
+  void set_encoded(const std::string& key, std::string json);
+  std::vector<std::pair<std::string, std::string>> entries_;
+};
+
+struct RunInfo {
+  // "complete", "incomplete: <reason>" or "checked" (validated by `shelldyn check`, not run).
+  std::string status;
+  std::string command;           // the command line, for reproduction
+  std::string sundials_version;  // passed in by the caller (SUNDIALS lives in integrators/); may be empty
+  JsonFields discretization;     // e.g. nodes, elements, dofs, constrained_dofs, total_mass
+  JsonFields summary;            // e.g. steps, final energy, drift, wall time
+};
+
+// Encodes a string as a JSON string literal (with quotes).
+std::string json_quote(const std::string& s);
+// Encodes a number with %.17g; NaN and infinities become null.
+std::string json_number(double v);
+
+// The whole document as text (pretty-printed, 2-space indentation).
+std::string run_json(const CaseSpec& spec, const RunInfo& info);
+// Writes run_json() to `path` via a temporary file and a rename (a reader never sees half a file).
+// Throws std::runtime_error on I/O errors.
+void write_run_json(const std::string& path, const CaseSpec& spec, const RunInfo& info);
+
+}  // namespace shelldyn

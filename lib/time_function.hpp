@@ -1,0 +1,54 @@
+// Scalar load-amplitude functions of time f(t), used by the case file's `loads[].function`
+// (spec/benchmarks.md §1.2 hat, §3.1 triangle). All functions are 0 for t < 0 except `constant`.
+//
+// A TimeFunction is a small immutable value; construct it with the named factories, which validate
+// their parameters and throw std::invalid_argument naming the parameter and the accepted range.
+#pragma once
+
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace shelldyn {
+
+class TimeFunction {
+ public:
+  enum class Kind { Constant, Ramp, Hat, Triangle, Table };
+
+  // f(t) = 1 for all t.
+  static TimeFunction constant();
+  // f(t) = min(t/t1, 1) for t >= 0, 0 for t < 0. Requires t1 > 0.
+  static TimeFunction ramp(double t1);
+  // Symmetric hat of benchmarks.md §1.2: t/t1 on [0, t1], 2 - t/t1 on [t1, 2 t1], 0 after. t1 > 0.
+  static TimeFunction hat(double t1);
+  // Triangle of benchmarks.md §3.1: 0 -> 1 on [0, t_peak], 1 -> 0 on [t_peak, t_end], 0 after.
+  // Requires 0 < t_peak < t_end.
+  static TimeFunction triangle(double t_peak, double t_end);
+  // Piecewise linear through (t_k, f_k); constant (f_0 resp. f_last) beyond the ends. At least one
+  // point, times strictly increasing, all values finite.
+  static TimeFunction table(std::vector<std::pair<double, double>> points);
+
+  TimeFunction() : TimeFunction(constant()) {}
+
+  double operator()(double t) const;
+  // Time after which f is identically 0, or +inf if it never vanishes for good. Loads whose
+  // functions have all ended leave the system free (benchmarks.md §0: H = K + V_int afterwards).
+  double end_of_support() const;
+
+  Kind kind() const { return kind_; }
+  const char* kind_name() const;
+  // The defining parameters in the case-file vocabulary, e.g. {{"t1", 2.5}} for a hat.
+  std::vector<std::pair<std::string, double>> parameters() const;
+  const std::vector<std::pair<double, double>>& table_points() const { return points_; }
+  // One-line human-readable form, e.g. "hat(t1=2.5)".
+  std::string describe() const;
+
+ private:
+  TimeFunction(Kind kind, double a, double b) : kind_(kind), a_(a), b_(b) {}
+  Kind kind_;
+  double a_ = 0.0;  // ramp/hat: t1; triangle: t_peak
+  double b_ = 0.0;  // triangle: t_end
+  std::vector<std::pair<double, double>> points_;  // table only
+};
+
+}  // namespace shelldyn

@@ -1,0 +1,168 @@
+#include "lib/vtu_writer.hpp"
+
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <set>
+#include <stdexcept>
+
+namespace shelldyn {
+
+namespace {
+
+constexpr int kVtkBiquadraticQuad = 28;
+
+// XML attribute values: field names come from users (monitor/extra names), so escape them.
+std::string xml_escape(const std::string& s) {
+  std::string out;
+  for (char c : s) {
+    switch (c) {
+      case '&': out += "&amp;"; break;
+      case '<': out += "&lt;"; break;
+      case '>': out += "&gt;"; break;
+      case '"': out += "&quot;"; break;
+      case '\'': out += "&apos;"; break;
+      default: out += c;
+    }
+  }
+  return out;
+}
+
+class File {
+ public:
+  explicit File(const std::string& path) : path_(path), f_(std::fopen(path.c_str(), "w")) {
+    if (!f_) throw std::runtime_error(path + ": cannot create file: " + std::strerror(errno));
+  }
+  ~File() {
+    if (f_) std::fclose(f_);
+  }
+  std::FILE* get() const { return f_; }
+  void close() {
+    const bool bad = std::ferror(f_) != 0;
+    const int rc = std::fclose(f_);
+    f_ = nullptr;
+    if (bad || rc != 0) throw std::runtime_error(path_ + ": write error: " + std::strerror(errno));
+  }
+
+ private:
+  std::string path_;
+  std::FILE* f_;
+};
+
+void check_size(size_t got, size_t want, const std::string& what) {
+  if (got != want)
+    throw std::invalid_argument("write_vtu: " + what + " has " + std::to_string(got) + " entries, expected " +
+                                std::to_string(want));
+}
+
+void write_vectors(std::FILE* f, const char* name, const std::vector<Vec3>& v) {
+  std::fprintf(f, "        <DataArray type=\"Float64\" Name=\"%s\" NumberOfComponents=\"3\" format=\"ascii\">\n", name);
+  for (const Vec3& x : v) std::fprintf(f, "          %.17g %.17g %.17g\n", x.x(), x.y(), x.z());
+  std::fprintf(f, "        </DataArray>\n");
+}
+
+void write_scalars(std::FILE* f, const ScalarField& s) {
+  std::fprintf(f, "        <DataArray type=\"Float64\" Name=\"%s\" format=\"ascii\">\n", xml_escape(s.name).c_str());
+  for (double v : s.values) std::fprintf(f, "          %.17g\n", v);
+  std::fprintf(f, "        </DataArray>\n");
+}
+
+}  // namespace
+
+std::string vtu_step_file_name(long long output_step) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "step_%06lld.vtu", output_step);
+  return buf;
+}
+
+void write_vtu(const std::string& path, const Mesh& mesh, const VtuFields& fields) {
+  const size_t np = mesh.X.size(), ne = mesh.elements.size();
+  check_size(fields.displacement.size(), np, "displacement");
+  check_size(fields.velocity.size(), np, "velocity");
+  check_size(fields.director.size(), np, "director");
+  std::set<std::string> names = {"displacement", "velocity", "director"};
+  for (const auto& s : fields.point_scalars) {
+    check_size(s.values.size(), np, "point field '" + s.name + "'");
+    if (s.name.empty() || !names.insert(s.name).second)
+      throw std::invalid_argument("write_vtu: point field name '" + s.name + "' is empty or repeated");
+  }
+  std::set<std::string> cell_names;
+  for (const auto& s : fields.cell_scalars) {
+    check_size(s.values.size(), ne, "cell field '" + s.name + "'");
+    if (s.name.empty() || !cell_names.insert(s.name).second)
+      throw std::invalid_argument("write_vtu: cell field name '" + s.name + "' is empty or repeated");
+  }
+  for (size_t e = 0; e < ne; ++e)
+    for (int a : mesh.elements[e])
+      if (a < 0 || static_cast<size_t>(a) >= np)
+        throw std::invalid_argument("write_vtu: element " + std::to_string(e) + " refers to node " +
+                                    std::to_string(a) + ", but the mesh has " + std::to_string(np) + " nodes");
+
+  File file(path);
+  std::FILE* f = file.get();
+  std::fprintf(f, "<?xml version=\"1.0\"?>\n");
+  std::fprintf(f, "<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\">\n");
+  std::fprintf(f, "  <UnstructuredGrid>\n");
+  std::fprintf(f, "    <Piece NumberOfPoints=\"%zu\" NumberOfCells=\"%zu\">\n", np, ne);
+  std::fprintf(f, "      <Points>\n");
+  std::fprintf(f, "        <DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">\n");
+  for (size_t i = 0; i < np; ++i) {
+    const Vec3 x = mesh.X[i] + fields.displacement[i];
+    std::fprintf(f, "          %.17g %.17g %.17g\n", x.x(), x.y(), x.z());
+  }
+  std::fprintf(f, "        </DataArray>\n      </Points>\n");
+  std::fprintf(f, "      <Cells>\n");
+  std::fprintf(f, "        <DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">\n");
+  for (const Quad9& el : mesh.elements) {
+    std::fprintf(f, "         ");
+    for (int a : el) std::fprintf(f, " %d", a);
+    std::fprintf(f, "\n");
+  }
+  std::fprintf(f, "        </DataArray>\n");
+  std::fprintf(f, "        <DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">\n");
+  for (size_t e = 0; e < ne; ++e) std::fprintf(f, "          %zu\n", 9 * (e + 1));
+  std::fprintf(f, "        </DataArray>\n");
+  std::fprintf(f, "        <DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\">\n");
+  for (size_t e = 0; e < ne; ++e) std::fprintf(f, "          %d\n", kVtkBiquadraticQuad);
+  std::fprintf(f, "        </DataArray>\n      </Cells>\n");
+  std::fprintf(f, "      <PointData Vectors=\"displacement\">\n");
+  write_vectors(f, "displacement", fields.displacement);
+  write_vectors(f, "velocity", fields.velocity);
+  write_vectors(f, "director", fields.director);
+  for (const auto& s : fields.point_scalars) write_scalars(f, s);
+  std::fprintf(f, "      </PointData>\n");
+  if (!fields.cell_scalars.empty()) {
+    std::fprintf(f, "      <CellData>\n");
+    for (const auto& s : fields.cell_scalars) write_scalars(f, s);
+    std::fprintf(f, "      </CellData>\n");
+  }
+  std::fprintf(f, "    </Piece>\n  </UnstructuredGrid>\n</VTKFile>\n");
+  file.close();
+}
+
+PvdWriter::PvdWriter(std::string pvd_path) : path_(std::move(pvd_path)) {}
+
+void PvdWriter::add(double time, const std::string& file) {
+  entries_.emplace_back(time, file);
+  // Write a complete new file and rename it over the old one: a reader never sees a half-written
+  // collection, and a killed run leaves the last complete list.
+  const std::string tmp = path_ + ".tmp";
+  {
+    File out(tmp);
+    std::FILE* f = out.get();
+    std::fprintf(f, "<?xml version=\"1.0\"?>\n");
+    std::fprintf(f, "<VTKFile type=\"Collection\" version=\"0.1\" byte_order=\"LittleEndian\">\n");
+    std::fprintf(f, "  <Collection>\n");
+    for (const auto& [t, name] : entries_)
+      std::fprintf(f, "    <DataSet timestep=\"%.17g\" group=\"\" part=\"0\" file=\"%s\"/>\n", t,
+                   xml_escape(name).c_str());
+    std::fprintf(f, "  </Collection>\n</VTKFile>\n");
+    out.close();
+  }
+  std::error_code ec;
+  std::filesystem::rename(tmp, path_, ec);
+  if (ec) throw std::runtime_error(path_ + ": cannot replace the collection file: " + ec.message());
+}
+
+}  // namespace shelldyn
