@@ -1,0 +1,105 @@
+// Timing of the CR9 element kernels (spec/element.md §3.4, §4, §6.3). Target: internal() with F and K
+// <= 50 µs per element. Run: build/bin/bench_element [--benchmark_filter=Internal]
+#include <benchmark/benchmark.h>
+
+#include <Eigen/Geometry>
+#include <array>
+#include <random>
+
+#include "elements/cr9_shell.hpp"
+#include "elements/shape_functions.hpp"
+
+namespace {
+
+using namespace shelldyn;
+
+struct Setup {
+  std::array<Eigen::Vector3d, 9> X0, p0;
+  CR9Shell::Charts charts;
+  CR9Shell::Vec45 u, u1;
+};
+
+// Cylindrical element (R = 2, 0.5 rad x 1) in a deformed state: translations ~0.05, directors turned.
+Setup make_setup() {
+  Setup s;
+  for (int k = 0; k < 9; ++k) {
+    const double phi = 0.25 * kNodeXi[k];
+    s.X0[k] = Eigen::Vector3d(2.0 * std::sin(phi), 0.5 * kNodeEta[k], 2.0 * std::cos(phi) - 2.0);
+    s.p0[k] = Eigen::Vector3d(std::sin(phi), 0.0, std::cos(phi));
+  }
+  std::mt19937 rng(1);
+  std::uniform_real_distribution<double> U(-1.0, 1.0);
+  for (int k = 0; k < 9; ++k) {
+    s.charts[k] = select_chart(s.p0[k]);
+    const Eigen::Vector3d p =
+        Eigen::AngleAxisd(0.1 * U(rng), Eigen::Vector3d(U(rng), U(rng), U(rng)).normalized()) * s.p0[k];
+    s.u.segment<3>(5 * k) = 0.05 * Eigen::Vector3d(U(rng), U(rng), U(rng));
+    s.u.segment<2>(5 * k + 3) = chart_coordinates(p, s.charts[k]);
+  }
+  s.u1 = s.u;
+  for (int k = 0; k < 9; ++k) s.u1.segment<3>(5 * k) += 0.001 * Eigen::Vector3d(U(rng), U(rng), U(rng));
+  return s;
+}
+
+const ShellMaterial kMat{1e6, 0.3, 1.0, 0.05};
+
+void BM_InternalForceAndTangent(benchmark::State& state) {
+  const Setup s = make_setup();
+  const CR9Shell e(s.X0, s.p0, kMat);
+  CR9Shell::Vec45 F;
+  CR9Shell::Mat45 K;
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(e.internal(s.u, s.charts, &F, &K));
+    benchmark::ClobberMemory();
+  }
+}
+BENCHMARK(BM_InternalForceAndTangent)->Unit(benchmark::kMicrosecond);
+
+void BM_InternalForceOnly(benchmark::State& state) {
+  const Setup s = make_setup();
+  const CR9Shell e(s.X0, s.p0, kMat);
+  CR9Shell::Vec45 F;
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(e.internal(s.u, s.charts, &F, nullptr));
+    benchmark::ClobberMemory();
+  }
+}
+BENCHMARK(BM_InternalForceOnly)->Unit(benchmark::kMicrosecond);
+
+void BM_AlgorithmicForceAndTangent(benchmark::State& state) {
+  const Setup s = make_setup();
+  const CR9Shell e(s.X0, s.p0, kMat);
+  CR9Shell::Vec45 F;
+  CR9Shell::Mat45 K;
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(e.algorithmic_internal(s.u, s.u1, s.charts, 0.5, 0.0, &F, &K));
+    benchmark::ClobberMemory();
+  }
+}
+BENCHMARK(BM_AlgorithmicForceAndTangent)->Unit(benchmark::kMicrosecond);
+
+void BM_MassAndInertial(benchmark::State& state) {
+  const Setup s = make_setup();
+  const CR9Shell e(s.X0, s.p0, kMat);
+  CR9Shell::Mat45 M;
+  CR9Shell::Vec45 Fm;
+  for (auto _ : state) {
+    e.mass(s.u, s.charts, &M);
+    e.inertial(s.u, s.u1, s.charts, &Fm);
+    benchmark::ClobberMemory();
+  }
+}
+BENCHMARK(BM_MassAndInertial)->Unit(benchmark::kMicrosecond);
+
+void BM_Construct(benchmark::State& state) {
+  const Setup s = make_setup();
+  for (auto _ : state) {
+    CR9Shell e(s.X0, s.p0, kMat);
+    benchmark::DoNotOptimize(e.area());
+  }
+}
+BENCHMARK(BM_Construct)->Unit(benchmark::kMicrosecond);
+
+}  // namespace
+
+BENCHMARK_MAIN();
