@@ -1,0 +1,67 @@
+// Bad input is rejected with exceptions that say what and where (spec §2.1 guard, §2.4 orientation).
+#include <gtest/gtest.h>
+
+#include <stdexcept>
+#include <string>
+
+#include "element_fixtures.hpp"
+
+namespace shelldyn::testing {
+namespace {
+
+template <class Ex, class F>
+std::string message_of(F&& f) {
+  try {
+    f();
+  } catch (const Ex& e) {
+    return e.what();
+  }
+  return "<no exception>";
+}
+
+TEST(CR9Errors, OrientationCheckNamesTheNode) {
+  Geometry g = make_geometry(Shape::Cylinder, Facing::Z);
+  g.p0[6] = -g.p0[6];  // node 7 normal flipped
+  const std::string msg = message_of<std::invalid_argument>([&] { CR9Shell e(g.X0, g.p0, test_material()); });
+  EXPECT_NE(msg.find("node 7"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("orientation"), std::string::npos) << msg;
+  // Clockwise numbering: all normals point against e_z0.
+  Geometry c = make_geometry(Shape::Flat, Facing::Z);
+  for (auto& p : c.p0) p = -p;
+  EXPECT_THROW(CR9Shell(c.X0, c.p0, test_material()), std::invalid_argument);
+}
+
+TEST(CR9Errors, BadMaterialAndNormalsAreRejected) {
+  const Geometry g = make_geometry(Shape::Flat, Facing::Z);
+  ShellMaterial m = test_material();
+  m.nu = 0.5;
+  EXPECT_NE(message_of<std::invalid_argument>([&] { CR9Shell e(g.X0, g.p0, m); }).find("nu"), std::string::npos);
+  m = test_material();
+  m.thickness = 0.0;
+  EXPECT_NE(message_of<std::invalid_argument>([&] { CR9Shell e(g.X0, g.p0, m); }).find("thickness"),
+            std::string::npos);
+  Geometry h = g;
+  h.p0[2] *= 1.1;
+  EXPECT_NE(message_of<std::invalid_argument>([&] { CR9Shell e(h.X0, h.p0, test_material()); }).find("node 3"),
+            std::string::npos);
+  Geometry d = g;
+  d.X0[2] = d.X0[0];  // collapsed diagonal
+  EXPECT_THROW(CR9Shell(d.X0, d.p0, test_material()), std::invalid_argument);
+}
+
+TEST(CR9Errors, OvershootingDirectorThrowsDomainError) {
+  const Geometry g = make_geometry(Shape::Flat, Facing::Z);
+  const CR9Shell e(g.X0, g.p0, test_material());
+  const Charts ch = initial_charts(g);
+  Vec45 u = Vec45::Zero();
+  for (int k = 0; k < 9; ++k) u.segment<2>(5 * k + 3) = chart_coordinates(g.p0[k], ch[k]);
+  u.segment<2>(5 * 4 + 3) = Eigen::Vector2d(0.9, 0.6);  // 1 - |q|^2 < 0 at node 5
+  Vec45 F;
+  EXPECT_THROW(e.internal(u, ch, &F, nullptr), std::domain_error);
+  EXPECT_THROW(e.algorithmic_internal(u, u, ch, 0.5, 0.0, &F, nullptr), std::domain_error);
+  EXPECT_THROW(e.algorithmic_internal(Vec45::Zero(), Vec45::Zero(), ch, 1.5, 0.0, &F, nullptr),
+               std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace shelldyn::testing
