@@ -1,0 +1,130 @@
+#include "integrators/sundials_support.hpp"
+
+#include <algorithm>
+#include <cstdlib>
+#include <sstream>
+#include <stdexcept>
+
+namespace shelldyn {
+
+SunContext::SunContext() {
+  // nullptr communicator = serial (SUNDIALS 6.x signature, stack.md §3.2).
+  const int flag = SUNContext_Create(nullptr, &ctx_);
+  if (flag != 0 || ctx_ == nullptr)
+    throw std::runtime_error("SUNContext_Create failed with flag " + std::to_string(flag));
+}
+
+SunContext::~SunContext() {
+  if (ctx_) SUNContext_Free(&ctx_);
+}
+
+std::string flag_name(FlagNameFn fn, long int flag) {
+  if (fn == nullptr) return {};
+  char* s = fn(flag);
+  if (s == nullptr) return {};
+  std::string out(s);
+  std::free(s);  // SUNDIALS 6 allocates these names with malloc
+  return out;
+}
+
+void check_flag(int flag, const char* call, FlagNameFn fn) {
+  if (flag >= 0) return;
+  std::ostringstream os;
+  os << call << " failed with flag " << flag;
+  const std::string name = flag_name(fn, flag);
+  if (!name.empty()) os << " (" << name << ")";
+  throw std::runtime_error(os.str());
+}
+
+void check_ptr(const void* p, const char* call) {
+  if (p == nullptr)
+    throw std::runtime_error(std::string(call) + " returned NULL (out of memory or invalid input)");
+}
+
+NVectorPtr make_serial_vector(Index n, SUNContext ctx, const double* init) {
+  if (n <= 0) throw std::invalid_argument("make_serial_vector: length must be positive, got " + std::to_string(n));
+  NVectorPtr v(N_VNew_Serial(n, ctx));
+  check_ptr(v.get(), "N_VNew_Serial");
+  if (init) std::copy(init, init + n, data(v.get()));
+  else N_VConst(0.0, v.get());
+  return v;
+}
+
+double* data(N_Vector v) {
+  double* p = N_VGetArrayPointer(v);
+  check_ptr(p, "N_VGetArrayPointer");
+  return p;
+}
+
+SunMatrixPtr make_csc_matrix(const SparsePattern& pattern, SUNContext ctx) {
+  if (pattern.n <= 0 || pattern.colptr.size() != static_cast<size_t>(pattern.n) + 1)
+    throw std::invalid_argument("make_csc_matrix: pattern has n = " + std::to_string(pattern.n) +
+                                " and " + std::to_string(pattern.colptr.size()) + " column pointers");
+  // SUNSparseMatrix refuses a zero capacity; an all-zero pattern still gets one slot.
+  SunMatrixPtr A(SUNSparseMatrix(pattern.n, pattern.n, std::max<Index>(pattern.nnz(), 1), CSC_MAT, ctx));
+  check_ptr(A.get(), "SUNSparseMatrix");
+  std::copy(pattern.colptr.begin(), pattern.colptr.end(), SUNSparseMatrix_IndexPointers(A.get()));
+  std::copy(pattern.rowind.begin(), pattern.rowind.end(), SUNSparseMatrix_IndexValues(A.get()));
+  std::fill_n(SUNSparseMatrix_Data(A.get()), pattern.nnz(), 0.0);
+  return A;
+}
+
+void copy_to_sun_matrix(const SparseMatrix& M, SUNMatrix A) {
+  const SparsePattern& P = *M.pattern;
+  if (SUNMatGetID(A) != SUNMATRIX_SPARSE || SUNSparseMatrix_SparseType(A) != CSC_MAT)
+    throw std::invalid_argument("copy_to_sun_matrix: target is not a CSC SUNSparseMatrix");
+  if (SUNSparseMatrix_Rows(A) != P.n || SUNSparseMatrix_Columns(A) != P.n ||
+      SUNSparseMatrix_NNZ(A) < P.nnz() || static_cast<Index>(M.values.size()) != P.nnz()) {
+    std::ostringstream os;
+    os << "copy_to_sun_matrix: matrix n = " << P.n << ", nnz = " << P.nnz() << ", values = "
+       << M.values.size() << " does not fit SUNSparseMatrix " << SUNSparseMatrix_Rows(A) << " x "
+       << SUNSparseMatrix_Columns(A) << " with capacity " << SUNSparseMatrix_NNZ(A);
+    throw std::invalid_argument(os.str());
+  }
+  std::copy(P.colptr.begin(), P.colptr.end(), SUNSparseMatrix_IndexPointers(A));
+  std::copy(P.rowind.begin(), P.rowind.end(), SUNSparseMatrix_IndexValues(A));
+  std::copy(M.values.begin(), M.values.end(), SUNSparseMatrix_Data(A));
+}
+
+CscView csc_view(SUNMatrix A) {
+  if (SUNMatGetID(A) != SUNMATRIX_SPARSE || SUNSparseMatrix_SparseType(A) != CSC_MAT)
+    throw std::invalid_argument("csc_view: matrix is not a CSC SUNSparseMatrix");
+  CscView v;
+  v.n = SUNSparseMatrix_Columns(A);
+  v.colptr = SUNSparseMatrix_IndexPointers(A);
+  v.rowind = SUNSparseMatrix_IndexValues(A);
+  v.values = SUNSparseMatrix_Data(A);
+  return v;
+}
+
+void CallbackError::capture(const char* where) noexcept {
+  if (!message_.empty()) return;
+  try {
+    throw;
+  } catch (const std::exception& e) {
+    try {
+      message_ = std::string(where) + ": " + e.what();
+    } catch (...) {
+    }
+  } catch (...) {
+    try {
+      message_ = std::string(where) + ": unknown exception";
+    } catch (...) {
+    }
+  }
+}
+
+void record_sundials_error(int error_code, const char* module, const char* function, char* msg,
+                           void* user_data) {
+  if (user_data == nullptr) return;
+  try {
+    auto& out = *static_cast<std::string*>(user_data);
+    std::ostringstream os;
+    os << "[" << (module ? module : "?") << " " << (error_code < 0 ? "ERROR" : "WARNING") << "] "
+       << (function ? function : "?") << ": " << (msg ? msg : "");
+    out = os.str();
+  } catch (...) {
+  }
+}
+
+}  // namespace shelldyn
