@@ -16,6 +16,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>  // Vec3::cross is used wherever meshes are
 #include <array>
 #include <map>
 #include <string>

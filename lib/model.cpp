@@ -1,0 +1,222 @@
+#include "lib/model.hpp"
+
+#include <exception>
+#include <mutex>
+#include <stdexcept>
+#include <string>
+
+namespace shelldyn {
+namespace {
+
+// Runs body(e) for every element, colour by colour; elements of one colour share no node, so their
+// scatter operations never collide. The first exception thrown by any element is rethrown afterwards
+// (exceptions must not leave an OpenMP region).
+template <class Body>
+void for_each_element(const Assembler& assembler, const Body& body) {
+  std::exception_ptr error;
+  std::mutex error_mutex;
+  for (const auto& colour : assembler.colours()) {
+    const int count = static_cast<int>(colour.size());
+#pragma omp parallel for schedule(dynamic, 4)
+    for (int k = 0; k < count; ++k) {
+      try {
+        body(colour[static_cast<size_t>(k)]);
+      } catch (...) {
+        std::lock_guard<std::mutex> lock(error_mutex);
+        if (!error) error = std::current_exception();
+      }
+    }
+    if (error) std::rethrow_exception(error);
+  }
+}
+
+double sum(const std::vector<double>& values) {
+  double s = 0.0;
+  for (double x : values) s += x;  // fixed order: independent of the thread count
+  return s;
+}
+
+}  // namespace
+
+Model::Model(Mesh mesh, std::vector<Vec3> normals, const ShellMaterial& material, DofMap dofs,
+             std::vector<NodalLoad> loads, CR9Shell::Options options)
+    : mesh_(std::move(mesh)),
+      normals_(std::move(normals)),
+      material_(material),
+      dofs_(std::move(dofs)),
+      loads_(std::move(loads)),
+      assembler_(mesh_.elements, mesh_.num_nodes()) {
+  if (normals_.size() != mesh_.X.size())
+    throw std::invalid_argument("Model: " + std::to_string(normals_.size()) + " normals for " +
+                                std::to_string(mesh_.X.size()) + " nodes");
+  if (dofs_.num_nodes() != mesh_.num_nodes())
+    throw std::invalid_argument("Model: DOF map and mesh disagree on the number of nodes");
+  for (const auto& load : loads_)
+    if (load.node < 0 || load.node >= mesh_.num_nodes())
+      throw std::invalid_argument("Model: load on node " + std::to_string(load.node) + " outside the mesh");
+  elements_.reserve(mesh_.elements.size());
+  for (size_t e = 0; e < mesh_.elements.size(); ++e) {
+    std::array<Vec3, 9> X0, p0;
+    for (int a = 0; a < 9; ++a) {
+      X0[static_cast<size_t>(a)] = mesh_.X[static_cast<size_t>(mesh_.elements[e][static_cast<size_t>(a)])];
+      p0[static_cast<size_t>(a)] = normals_[static_cast<size_t>(mesh_.elements[e][static_cast<size_t>(a)])];
+    }
+    try {
+      elements_.emplace_back(X0, p0, material, options);
+    } catch (const std::exception& ex) {
+      throw std::invalid_argument("element " + std::to_string(e) + ": " + ex.what());
+    }
+  }
+  dofs_.resolve(initial_state().charts);  // director-component constraints need the initial charts
+}
+
+SparseMatrix Model::make_matrix() const {
+  return SparseMatrix{pattern(), std::vector<double>(static_cast<size_t>(pattern()->nnz()), 0.0)};
+}
+
+State Model::initial_state() const {
+  State s;
+  const Index n = num_dofs();
+  s.u = Eigen::VectorXd::Zero(n);
+  s.v = Eigen::VectorXd::Zero(n);
+  s.a = Eigen::VectorXd::Zero(n);
+  s.charts.resize(normals_.size());
+  for (size_t i = 0; i < normals_.size(); ++i) {
+    s.charts[i] = select_chart(normals_[i]);
+    s.u.segment<2>(DofMap::dof(static_cast<int>(i), 3)) = chart_coordinates(normals_[i], s.charts[i]);
+  }
+  return s;
+}
+
+void Model::gather(int e, const Eigen::VectorXd& global, CR9Shell::Vec45& ue) const {
+  assembler_.gather(e, global.data(), ue);
+}
+
+CR9Shell::Charts Model::element_charts(int e, const std::vector<DirectorChart>& charts) const {
+  CR9Shell::Charts ch;
+  const auto& nodes = mesh_.elements[static_cast<size_t>(e)];
+  for (size_t a = 0; a < 9; ++a) ch[a] = charts[static_cast<size_t>(nodes[a])];
+  return ch;
+}
+
+double Model::internal(const Eigen::VectorXd& u, const std::vector<DirectorChart>& charts, double* F,
+                       SparseMatrix* K) const {
+  if (F) std::fill(F, F + num_dofs(), 0.0);
+  if (K) K->set_zero();
+  std::vector<double> energy(elements_.size(), 0.0);
+  for_each_element(assembler_, [&](int e) {
+    CR9Shell::Vec45 ue, fe;
+    CR9Shell::Mat45 ke;
+    gather(e, u, ue);
+    energy[static_cast<size_t>(e)] =
+        elements_[static_cast<size_t>(e)].internal(ue, element_charts(e, charts), F ? &fe : nullptr, K ? &ke : nullptr);
+    if (F) assembler_.add_vector(e, fe, F);
+    if (K) assembler_.add_matrix(e, ke, K->values.data());
+  });
+  return sum(energy);
+}
+
+double Model::algorithmic_internal(const Eigen::VectorXd& u_n, const Eigen::VectorXd& u_np1,
+                                   const std::vector<DirectorChart>& charts, double alpha_f, double xi,
+                                   double* F, SparseMatrix* K) const {
+  if (F) std::fill(F, F + num_dofs(), 0.0);
+  if (K) K->set_zero();
+  std::vector<double> energy(elements_.size(), 0.0);
+  for_each_element(assembler_, [&](int e) {
+    CR9Shell::Vec45 un, unp1, fe;
+    CR9Shell::Mat45 ke;
+    gather(e, u_n, un);
+    gather(e, u_np1, unp1);
+    energy[static_cast<size_t>(e)] = elements_[static_cast<size_t>(e)].algorithmic_internal(
+        un, unp1, element_charts(e, charts), alpha_f, xi, F ? &fe : nullptr, K ? &ke : nullptr);
+    if (F) assembler_.add_vector(e, fe, F);
+    if (K) assembler_.add_matrix(e, ke, K->values.data());
+  });
+  return sum(energy);
+}
+
+void Model::mass(const Eigen::VectorXd& u, const std::vector<DirectorChart>& charts, SparseMatrix& M) const {
+  M.set_zero();
+  for_each_element(assembler_, [&](int e) {
+    CR9Shell::Vec45 ue;
+    CR9Shell::Mat45 me;
+    gather(e, u, ue);
+    elements_[static_cast<size_t>(e)].mass(ue, element_charts(e, charts), &me);
+    assembler_.add_matrix(e, me, M.values.data());
+  });
+}
+
+void Model::inertial(const Eigen::VectorXd& u, const Eigen::VectorXd& v, const std::vector<DirectorChart>& charts,
+                     double* Fm) const {
+  std::fill(Fm, Fm + num_dofs(), 0.0);
+  for_each_element(assembler_, [&](int e) {
+    CR9Shell::Vec45 ue, ve, fe;
+    gather(e, u, ue);
+    gather(e, v, ve);
+    elements_[static_cast<size_t>(e)].inertial(ue, ve, element_charts(e, charts), &fe);
+    assembler_.add_vector(e, fe, Fm);
+  });
+}
+
+void Model::external(double t, const Eigen::VectorXd& u, const std::vector<DirectorChart>& charts,
+                     double* F) const {
+  std::fill(F, F + num_dofs(), 0.0);
+  for (const auto& load : loads_) {
+    const double f = load.function(t);
+    if (f == 0.0) continue;
+    if (load.kind == NodalLoad::Kind::Force) {
+      for (int c = 0; c < 3; ++c) F[DofMap::dof(load.node, c)] += f * load.vector[c];
+    } else {
+      // Dead moment m: δW = m·δφ with δp = δφ × p, so f_q = A1ᵀ (m × p) (spec/element.md §2.3 item 3).
+      const Eigen::Vector2d q = u.segment<2>(DofMap::dof(load.node, 3));
+      const DirectorChart& ch = charts[static_cast<size_t>(load.node)];
+      const Eigen::Vector2d fq = director_A1(q, ch).transpose() * (f * load.vector).cross(shelldyn::director(q, ch));
+      F[DofMap::dof(load.node, 3)] += fq[0];
+      F[DofMap::dof(load.node, 4)] += fq[1];
+    }
+  }
+}
+
+Invariants Model::invariants(const State& s) const {
+  Invariants inv;
+  std::vector<double> kinetic(elements_.size(), 0.0);
+  std::vector<Vec3> L(elements_.size(), Vec3::Zero()), J(elements_.size(), Vec3::Zero());
+  for_each_element(assembler_, [&](int e) {
+    CR9Shell::Vec45 ue, ve;
+    gather(e, s.u, ue);
+    gather(e, s.v, ve);
+    const auto ch = element_charts(e, s.charts);
+    const auto& el = elements_[static_cast<size_t>(e)];
+    kinetic[static_cast<size_t>(e)] = el.kinetic(ue, ve, ch);
+    el.momenta(ue, ve, ch, &L[static_cast<size_t>(e)], &J[static_cast<size_t>(e)]);
+  });
+  inv.kinetic = sum(kinetic);
+  for (size_t e = 0; e < elements_.size(); ++e) {
+    inv.L += L[e];
+    inv.J += J[e];
+  }
+  inv.strain = internal(s.u, s.charts, nullptr, nullptr);
+  return inv;
+}
+
+Vec3 Model::director(const State& s, int node) const {
+  return shelldyn::director(s.u.segment<2>(DofMap::dof(node, 3)), s.charts[static_cast<size_t>(node)]);
+}
+
+int Model::rechart(State& s, double hysteresis) {
+  int switched = 0;
+  for (int i = 0; i < mesh_.num_nodes(); ++i) {
+    const Index k = DofMap::dof(i, 3);
+    Eigen::Vector2d q = s.u.segment<2>(k), qd = s.v.segment<2>(k), qdd = s.a.segment<2>(k);
+    if (shelldyn::rechart(q, qd, qdd, s.charts[static_cast<size_t>(i)], hysteresis)) {
+      s.u.segment<2>(k) = q;
+      s.v.segment<2>(k) = qd;
+      s.a.segment<2>(k) = qdd;
+      ++switched;
+    }
+  }
+  if (switched) dofs_.resolve(s.charts);
+  return switched;
+}
+
+}  // namespace shelldyn

@@ -1,0 +1,99 @@
+// The semi-discretization M(q) q̈ + F_m(q, q̇) + F_int(q) = F_ext(t)   (paper eq. 26; spec/element.md §5.3)
+// of a mesh of CR9 shell elements (architecture.md §4.2).
+//
+// The Model knows nothing about time integration: it evaluates forces, matrices, energies and momenta
+// at states it is given. Matrices are assembled into storage the caller owns, on one fixed CSC pattern
+// (assembler()); nothing is allocated per call. Element loops run in parallel over conflict-free
+// element colours (OpenMP); results do not depend on the thread count beyond round-off.
+//
+// Constraints: the Model assembles the unconstrained system; integrators apply the DofMap (identity
+// rows/columns, lib/assembler.hpp apply_dirichlet). Director-component constraints follow chart
+// switches: rechart() re-resolves the DofMap.
+#pragma once
+
+#include "elements/cr9_shell.hpp"
+#include "lib/assembler.hpp"
+#include "lib/dof_map.hpp"
+#include "lib/mesh.hpp"
+#include "lib/sparse_matrix.hpp"
+#include "lib/state.hpp"
+#include "lib/time_function.hpp"
+
+#include <Eigen/Core>
+#include <vector>
+
+namespace shelldyn {
+
+// A load on one node: a dead force (global vector) or a dead moment m, whose generalised force on the
+// director unknowns is A1ᵀ (m × p) (spec/element.md §2.3 item 3), both scaled by f(t).
+struct NodalLoad {
+  enum class Kind { Force, Moment };
+  int node = 0;
+  Kind kind = Kind::Force;
+  Vec3 vector = Vec3::Zero();
+  TimeFunction function;
+};
+
+struct Invariants {
+  double kinetic = 0.0;   // ½ q̇ᵀ M(q) q̇  (§5.4)
+  double strain = 0.0;    // Σ U_e
+  Vec3 L = Vec3::Zero();  // linear momentum
+  Vec3 J = Vec3::Zero();  // angular momentum about the origin, director term included
+};
+
+class Model {
+ public:
+  // normals: initial unit nodal normals p_i0 (lib/nodal_normals.hpp). Throws if an element fails the
+  // orientation check or the material is invalid (messages name the element).
+  Model(Mesh mesh, std::vector<Vec3> normals, const ShellMaterial& material, DofMap dofs,
+        std::vector<NodalLoad> loads = {}, CR9Shell::Options options = {});
+
+  const Mesh& mesh() const { return mesh_; }
+  const std::vector<Vec3>& normals() const { return normals_; }
+  const ShellMaterial& material() const { return material_; }
+  const Assembler& assembler() const { return assembler_; }
+  const DofMap& dofs() const { return dofs_; }
+  const std::vector<NodalLoad>& loads() const { return loads_; }
+  const CR9Shell& element(int e) const { return elements_[static_cast<size_t>(e)]; }
+  Index num_dofs() const { return assembler_.num_dofs(); }
+  std::shared_ptr<const SparsePattern> pattern() const { return assembler_.pattern(); }
+  SparseMatrix make_matrix() const;  // zero matrix on the model's pattern
+
+  // The reference state: t = 0, d = 0, q = minor components of p_i0 in freshly selected charts, v = a = 0.
+  State initial_state() const;
+
+  // F_int(q), K = ∂F_int/∂q (exact, symmetric), returns V = Σ U_e. F or K may be null.
+  double internal(const Eigen::VectorXd& u, const std::vector<DirectorChart>& charts, double* F,
+                  SparseMatrix* K) const;
+  // Strain-averaged force F*_int,mid and its symmetric tangent K_mid (spec/element.md §6.3); returns V(u_np1).
+  double algorithmic_internal(const Eigen::VectorXd& u_n, const Eigen::VectorXd& u_np1,
+                              const std::vector<DirectorChart>& charts, double alpha_f, double xi, double* F,
+                              SparseMatrix* K) const;
+  void mass(const Eigen::VectorXd& u, const std::vector<DirectorChart>& charts, SparseMatrix& M) const;
+  void inertial(const Eigen::VectorXd& u, const Eigen::VectorXd& v, const std::vector<DirectorChart>& charts,
+                double* Fm) const;
+  // F_ext(t, q) (overwrites F). Moments depend on q through p and A1.
+  void external(double t, const Eigen::VectorXd& u, const std::vector<DirectorChart>& charts, double* F) const;
+  Invariants invariants(const State& s) const;
+
+  // Current director of node i.
+  Vec3 director(const State& s, int node) const;
+
+  // Re-selects director charts between increments (spec/element.md §2.3), converting u, v, a, and
+  // re-resolves director constraints. Returns the number of nodes whose chart switched.
+  int rechart(State& s, double hysteresis = 1.0);
+
+ private:
+  void gather(int e, const Eigen::VectorXd& global, CR9Shell::Vec45& ue) const;
+  CR9Shell::Charts element_charts(int e, const std::vector<DirectorChart>& charts) const;
+
+  Mesh mesh_;
+  std::vector<Vec3> normals_;
+  ShellMaterial material_;
+  DofMap dofs_;
+  std::vector<NodalLoad> loads_;
+  Assembler assembler_;
+  std::vector<CR9Shell> elements_;
+};
+
+}  // namespace shelldyn
