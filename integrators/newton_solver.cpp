@@ -1,0 +1,346 @@
+// KINSOL-driven Newton solver; the design (one KINSol call per iteration, residual cache, setup
+// control, stopping tests) is explained in the header.
+#include "integrators/newton_solver.hpp"
+
+#include "integrators/sun_linear_solver.hpp"
+#include "integrators/sundials_support.hpp"
+
+#include <kinsol/kinsol.h>
+#include <kinsol/kinsol_ls.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <sstream>
+#include <stdexcept>
+#include <vector>
+
+namespace shelldyn {
+
+std::string to_string(NewtonSolver::StopReason r) {
+  switch (r) {
+    case NewtonSolver::StopReason::none: return "none";
+    case NewtonSolver::StopReason::fnorm: return "fnorm";
+    case NewtonSolver::StopReason::step: return "step";
+    case NewtonSolver::StopReason::initial_guess: return "initial_guess";
+    case NewtonSolver::StopReason::energy: return "energy";
+    case NewtonSolver::StopReason::hook: return "hook";
+    case NewtonSolver::StopReason::failure: return "failure";
+    case NewtonSolver::StopReason::max_iters: return "max_iters";
+  }
+  return "?";
+}
+
+namespace {
+
+void check_kin(int flag, const char* call) { check_flag(flag, call, KINGetReturnFlagName); }
+
+void validate(const NewtonOptions& o) {
+  auto bad = [](const std::string& what) {
+    throw std::invalid_argument("NewtonOptions: " + what);
+  };
+  if (o.max_iters < 1) bad("max_iters must be >= 1, got " + std::to_string(o.max_iters));
+  if (o.min_iters < 0 || o.min_iters > o.max_iters)
+    bad("min_iters must be in [0, max_iters = " + std::to_string(o.max_iters) + "], got " +
+        std::to_string(o.min_iters));
+  if (o.max_setup_calls < 1) bad("max_setup_calls must be >= 1, got " + std::to_string(o.max_setup_calls));
+  if (!(o.fnorm_tol > 0)) bad("fnorm_tol must be > 0, got " + std::to_string(o.fnorm_tol));
+  if (!(o.step_tol >= 0)) bad("step_tol must be >= 0, got " + std::to_string(o.step_tol));
+  if (!(o.max_newton_step > 0)) bad("max_newton_step must be > 0");
+  if (o.stop != StopTest::fnorm && !(o.energy_tol > 0))
+    bad("energy_tol must be > 0 when the energy test is used, got " + std::to_string(o.energy_tol));
+  if (!(o.energy_floor >= 0)) bad("energy_floor must be >= 0");
+  const auto names = linear_solver_names();
+  if (std::find(names.begin(), names.end(), o.linear_solver) == names.end())
+    make_linear_solver(o.linear_solver);  // throws with the list of valid names
+}
+
+}  // namespace
+
+struct NewtonSolver::Impl {
+  // Declaration order = construction order; SUNDIALS objects are destroyed before the context.
+  std::shared_ptr<const SparsePattern> pattern;
+  NewtonOptions opt;
+  SunContext ctx;
+  Index n = 0;
+  NVectorPtr u, uscale, fscale;
+  SunMatrixPtr J;
+  SunLinearSolverPtr LS;
+  void* kin = nullptr;
+  std::string kinsol_msg;  // last message of KINSOL's error handler
+  SparseMatrix Jwork;      // what the user's Jacobian fills
+
+  // Per-solve state, read by the C callbacks.
+  const Residual* residual = nullptr;
+  const Jacobian* jacobian = nullptr;
+  CallbackError cb_error;
+  std::vector<double> cache_u, cache_f, f_start, u_prev, du;
+  bool cache_valid = false, first_eval_in_call = false;
+  int residual_evals = 0, jacobian_evals = 0;
+
+  // Modified Newton bookkeeping (across solve() calls).
+  bool have_jacobian = false, force_setup = false;
+  int since_setup = 0;
+
+  ~Impl() {
+    if (kin) KINFree(&kin);
+  }
+
+  static int residual_cb(N_Vector uu, N_Vector ff, void* user_data) {
+    auto* s = static_cast<Impl*>(user_data);
+    try {
+      const double* up = N_VGetArrayPointer(uu);
+      double* fp = N_VGetArrayPointer(ff);
+      const size_t bytes = sizeof(double) * static_cast<size_t>(s->n);
+      if (s->cache_valid && std::memcmp(up, s->cache_u.data(), bytes) == 0) {
+        std::memcpy(fp, s->cache_f.data(), bytes);
+      } else {
+        ++s->residual_evals;
+        (*s->residual)(up, fp);
+        for (Index i = 0; i < s->n; ++i)
+          if (!std::isfinite(fp[i]))
+            throw std::runtime_error("residual component " + std::to_string(i) + " is " +
+                                     std::to_string(fp[i]));
+        std::memcpy(s->cache_u.data(), up, bytes);
+        std::memcpy(s->cache_f.data(), fp, bytes);
+        s->cache_valid = true;
+      }
+      if (s->first_eval_in_call) {  // KINSolInit's evaluation at the call's initial iterate
+        std::memcpy(s->f_start.data(), fp, bytes);
+        s->first_eval_in_call = false;
+      }
+      return 0;
+    } catch (...) {
+      s->cb_error.capture("residual callback");
+      return -1;  // unrecoverable: KINSOL stops with KIN_SYSFUNC_FAIL / KIN_FIRST_SYSFUNC_ERR
+    }
+  }
+
+  static int jacobian_cb(N_Vector uu, N_Vector, SUNMatrix Jm, void* user_data, N_Vector, N_Vector) {
+    auto* s = static_cast<Impl*>(user_data);
+    try {
+      ++s->jacobian_evals;
+      (*s->jacobian)(N_VGetArrayPointer(uu), s->Jwork);
+      if (s->Jwork.pattern != s->pattern || static_cast<Index>(s->Jwork.values.size()) != s->pattern->nnz())
+        throw std::invalid_argument(
+            "the Jacobian callback changed the matrix pattern or the size of its value array; fill "
+            "J.values only");
+      // KINSOL zeroed Jm including its structure: refill everything (stack.md §3.2 pitfall 2).
+      copy_to_sun_matrix(s->Jwork, Jm);
+      return 0;
+    } catch (...) {
+      s->cb_error.capture("Jacobian callback");
+      return -1;  // KINSOL reports KIN_LSETUP_FAIL
+    }
+  }
+
+  double fnorm_inf(const double* f, const double* scale) const {
+    double m = 0;
+    for (Index i = 0; i < n; ++i) m = std::max(m, std::abs(scale[i] * f[i]));
+    return m;
+  }
+};
+
+NewtonSolver::NewtonSolver(std::shared_ptr<const SparsePattern> pattern, NewtonOptions options)
+    : impl_(std::make_unique<Impl>()) {
+  if (!pattern) throw std::invalid_argument("NewtonSolver: null sparsity pattern");
+  validate(options);
+  check_csc_pattern({pattern->n, pattern->colptr.data(), pattern->rowind.data(), nullptr},
+                    "NewtonSolver pattern");
+  Impl& s = *impl_;
+  s.pattern = pattern;
+  s.opt = std::move(options);
+  s.n = pattern->n;
+  s.u = make_serial_vector(s.n, s.ctx);
+  s.uscale = make_serial_vector(s.n, s.ctx);
+  s.fscale = make_serial_vector(s.n, s.ctx);
+  s.J = make_csc_matrix(*pattern, s.ctx);
+  s.LS.reset(make_sun_linear_solver(s.ctx, make_linear_solver(s.opt.linear_solver)));
+  s.Jwork.pattern = pattern;
+  s.Jwork.values.assign(pattern->nnz(), 0.0);
+  for (auto* v : {&s.cache_u, &s.cache_f, &s.f_start, &s.u_prev, &s.du}) v->assign(s.n, 0.0);
+
+  s.kin = KINCreate(s.ctx);
+  check_ptr(s.kin, "KINCreate");
+  check_kin(KINSetErrHandlerFn(s.kin, record_sundials_error, &s.kinsol_msg), "KINSetErrHandlerFn");
+  check_kin(KINInit(s.kin, Impl::residual_cb, s.u.get()), "KINInit");
+  check_kin(KINSetUserData(s.kin, &s), "KINSetUserData");
+  check_kin(KINSetLinearSolver(s.kin, s.LS.get(), s.J.get()), "KINSetLinearSolver");
+  check_kin(KINSetJacFn(s.kin, Impl::jacobian_cb), "KINSetJacFn");
+  // One Newton iteration per KINSol call (header). msbset >= 2 so that KINSOL itself never triggers
+  // a setup inside the call; setups are requested per call through KINSetNoInitSetup.
+  check_kin(KINSetNumMaxIters(s.kin, 1), "KINSetNumMaxIters");
+  check_kin(KINSetMaxSetupCalls(s.kin, 10), "KINSetMaxSetupCalls");
+  check_kin(KINSetNoResMon(s.kin, SUNTRUE), "KINSetNoResMon");
+  check_kin(KINSetMaxNewtonStep(s.kin, s.opt.max_newton_step), "KINSetMaxNewtonStep");
+  // KINSetScaledStepTol treats 0 as "default" (≈ 3.7e-11): use the smallest positive value instead.
+  check_kin(KINSetScaledStepTol(s.kin, s.opt.step_tol > 0 ? s.opt.step_tol
+                                                          : std::numeric_limits<double>::min()),
+            "KINSetScaledStepTol");
+}
+
+NewtonSolver::~NewtonSolver() = default;
+NewtonSolver::NewtonSolver(NewtonSolver&&) noexcept = default;
+NewtonSolver& NewtonSolver::operator=(NewtonSolver&&) noexcept = default;
+
+const NewtonOptions& NewtonSolver::options() const { return impl_->opt; }
+const LinearSolver& NewtonSolver::linear_solver() const { return sun_linear_solver_backend(impl_->LS.get()); }
+void NewtonSolver::invalidate_jacobian() { impl_->force_setup = true; }
+
+NewtonSolver::Result NewtonSolver::solve(double* u, const Residual& residual, const Jacobian& jacobian,
+                                         const double* fscale, const double* uscale,
+                                         const IterationHook& hook) {
+  Impl& s = *impl_;
+  const NewtonOptions& o = s.opt;
+  if (u == nullptr) throw std::invalid_argument("NewtonSolver::solve: u is null");
+  if (!residual || !jacobian)
+    throw std::invalid_argument("NewtonSolver::solve: residual and Jacobian callbacks are required");
+  const Index n = s.n;
+  double* uu = data(s.u.get());
+  std::copy(u, u + n, uu);
+  double* fs = data(s.fscale.get());
+  double* us = data(s.uscale.get());
+  for (Index i = 0; i < n; ++i) {
+    fs[i] = fscale ? fscale[i] : 1.0;
+    us[i] = uscale ? uscale[i] : 1.0;
+    if (!(fs[i] > 0) || !(us[i] > 0) || !std::isfinite(fs[i]) || !std::isfinite(us[i]))
+      throw std::invalid_argument("NewtonSolver::solve: scaling vectors must be positive and finite (index " +
+                                  std::to_string(i) + ")");
+  }
+
+  s.residual = &residual;
+  s.jacobian = &jacobian;
+  s.cb_error.clear();
+  s.kinsol_msg.clear();
+  s.cache_valid = false;  // F may differ from the previous solve (new time step)
+  s.residual_evals = s.jacobian_evals = 0;
+  const long factorizations0 = linear_solver().stats().factorizations;
+
+  const bool fnorm_test = o.stop != StopTest::energy;
+  const bool energy_test = o.stop != StopTest::fnorm;
+  const double tiny = std::numeric_limits<double>::min();
+  const int strategy = o.line_search ? KIN_LINESEARCH : KIN_NONE;
+
+  Result r;
+  double E0 = 0;
+  bool energy_ok = false;  // energy test at the current iterate
+  int k = 0;               // iterations done
+
+  auto finish = [&](bool converged, StopReason why, int flag, std::string msg) {
+    r.converged = converged;
+    r.stop_reason = why;
+    r.kinsol_flag = flag;
+    r.iterations = k;
+    r.residual_evals = s.residual_evals;
+    r.jacobian_evals = s.jacobian_evals;
+    r.factorizations = static_cast<int>(linear_solver().stats().factorizations - factorizations0);
+    if (s.cache_valid && std::memcmp(s.cache_u.data(), uu, sizeof(double) * n) == 0)
+      r.fnorm = s.fnorm_inf(s.cache_f.data(), fs);
+    else
+      r.fnorm = std::numeric_limits<double>::quiet_NaN();  // F never evaluated at u (early failure)
+    r.message = std::move(msg);
+    if (!converged) s.force_setup = true;  // do not reuse a Jacobian that just failed
+    std::copy(uu, uu + n, u);
+    s.residual = nullptr;
+    s.jacobian = nullptr;
+    return r;
+  };
+  auto failure_message = [&](int flag) {
+    std::ostringstream os;
+    if (s.cb_error.has_error()) os << s.cb_error.message() << "; ";
+    const std::string& ls = sun_linear_solver_last_error(s.LS.get());
+    if (!ls.empty()) os << ls << "; ";
+    os << "KINSol returned " << flag_name(KINGetReturnFlagName, flag) << " (" << flag << ") after "
+       << k << " iteration(s)";
+    double fn = 0;
+    if (KINGetFuncNorm(s.kin, &fn) == KIN_SUCCESS) os << ", last scaled ||F||_2 = " << fn;
+    if (!s.kinsol_msg.empty()) os << "; " << s.kinsol_msg;
+    return os.str();
+  };
+
+  while (k < o.max_iters) {
+    const bool need_setup = !o.modified || !s.have_jacobian || s.force_setup ||
+                            s.since_setup >= o.max_setup_calls;
+    check_kin(KINSetNoInitSetup(s.kin, need_setup ? SUNFALSE : SUNTRUE), "KINSetNoInitSetup");
+    std::copy(uu, uu + n, s.u_prev.begin());
+    const int jac0 = s.jacobian_evals;
+
+    // Before min_iters (or with the energy test alone) KINSOL must not stop on its own.
+    bool forced = !fnorm_test || k < o.min_iters;
+    int flag = 0;
+    for (;;) {
+      check_kin(KINSetFuncNormTol(s.kin, forced ? tiny : o.fnorm_tol), "KINSetFuncNormTol");
+      s.first_eval_in_call = true;
+      flag = KINSol(s.kin, s.u.get(), strategy, s.uscale.get(), s.fscale.get());
+      if (flag != KIN_INITIAL_GUESS_OK || forced) break;
+      // u_k already satisfies ‖F‖ ≤ 0.01 fnorm_tol: accept unless the energy test must also hold.
+      if (o.stop != StopTest::fnorm_and_energy || energy_ok || k == 0) break;
+      forced = true;  // make KINSOL iterate once more
+    }
+    if (s.cb_error.has_error() || (flag < 0 && flag != KIN_MAXITER_REACHED))
+      return finish(false, StopReason::failure, flag, failure_message(flag));
+    if (flag == KIN_INITIAL_GUESS_OK)  // no iteration in this call; F(u_k) is (numerically) zero
+      return finish(true, StopReason::initial_guess, flag, {});
+
+    long nni = 0;
+    check_kin(KINGetNumNonlinSolvIters(s.kin, &nni), "KINGetNumNonlinSolvIters");
+    const bool first_call = (k == 0);
+    k += static_cast<int>(nni);
+    if (s.jacobian_evals > jac0) {
+      s.have_jacobian = true;
+      s.force_setup = false;
+      s.since_setup = 0;
+    }
+    s.since_setup += static_cast<int>(nni);
+
+    // Energy criterion (element.md §6.5): E = |du · F(u_prev)|.
+    double E = 0;
+    for (Index i = 0; i < n; ++i) {
+      s.du[i] = uu[i] - s.u_prev[i];
+      E += s.du[i] * s.f_start[i];
+    }
+    E = std::abs(E);
+    if (first_call) E0 = E;
+    r.energy_ratio = (E0 <= o.energy_floor) ? 0.0 : E / E0;
+    // cc = 1 by definition after the first iteration; only the floor can accept there.
+    energy_ok = energy_test && r.energy_ratio <= o.energy_tol && (!first_call || E0 <= o.energy_floor);
+
+    bool hook_accept = false;
+    if (hook) {
+      try {
+        hook_accept = hook(k, uu, s.du.data(), s.f_start.data());
+      } catch (...) {
+        s.cb_error.capture("iteration hook");
+        return finish(false, StopReason::failure, flag, s.cb_error.message());
+      }
+    }
+    if (k < o.min_iters) continue;
+
+    const bool kinsol_ok = fnorm_test && (flag == KIN_SUCCESS || flag == KIN_STEP_LT_STPTOL);
+    const StopReason kinsol_reason = flag == KIN_SUCCESS ? StopReason::fnorm : StopReason::step;
+    switch (o.stop) {
+      case StopTest::fnorm:
+        if (kinsol_ok) return finish(true, kinsol_reason, flag, {});
+        break;
+      case StopTest::energy:
+        if (energy_ok) return finish(true, StopReason::energy, flag, {});
+        break;
+      case StopTest::fnorm_or_energy:
+        if (kinsol_ok) return finish(true, kinsol_reason, flag, {});
+        if (energy_ok) return finish(true, StopReason::energy, flag, {});
+        break;
+      case StopTest::fnorm_and_energy:
+        if (kinsol_ok && energy_ok) return finish(true, kinsol_reason, flag, {});
+        break;
+    }
+    if (hook_accept) return finish(true, StopReason::hook, flag, {});
+  }
+  std::ostringstream os;
+  os << "no convergence: KIN_MAXITER_REACHED after " << k << " iteration(s)";
+  if (s.cache_valid) os << ", ||fscale*F||_inf = " << s.fnorm_inf(s.cache_f.data(), fs);
+  if (energy_test) os << ", energy ratio cc = " << r.energy_ratio;
+  return finish(false, StopReason::max_iters, KIN_MAXITER_REACHED, os.str());
+}
+
+}  // namespace shelldyn
