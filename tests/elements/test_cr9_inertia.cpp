@@ -44,7 +44,7 @@ TEST(CR9Inertia, MassIsSymmetricPositiveDefinite) {
   EXPECT_LT((M - M.transpose()).norm(), 1e-15 * M.norm());
   Eigen::LLT<Mat45> llt(M);
   EXPECT_EQ(llt.info(), Eigen::Success);
-  // 3x3 Gauss integrates N_i N_j exactly on affine elements: Σ m_ij = area.
+  // Σ_i N_i = 1 at every point, so Σ_ij m_ij = ∫ dA = area (partition of unity of the mass).
   EXPECT_NEAR(e.scalar_mass().sum(), e.area(), 1e-14 * e.area());
 }
 
