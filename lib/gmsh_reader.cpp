@@ -63,7 +63,8 @@ class Lexer {
 
   int next_small_int(const std::string& what) {
     const long long v = next_int(what);
-    if (v < INT32_MIN || v > INT32_MAX) fail(what + " = " + std::to_string(v) + " is out of range" + context());
+    if (v < INT32_MIN || v > INT32_MAX)
+      fail(what + " = " + std::to_string(v) + " is out of range" + context());
     return static_cast<int>(v);
   }
 
@@ -130,21 +131,26 @@ class Lexer {
 // Node count per supported element type, 0 if unsupported.
 int nodes_per_element(int type) {
   switch (type) {
-    case 1: return 2;    // 2-node line
-    case 8: return 3;    // 3-node line
-    case 10: return 9;   // 9-node quadrangle (the shell element)
-    case 15: return 1;   // point
-    default: return 0;
+    case 1:
+      return 2;  // 2-node line
+    case 8:
+      return 3;  // 3-node line
+    case 10:
+      return 9;  // 9-node quadrangle (the shell element)
+    case 15:
+      return 1;  // point
+    default:
+      return 0;
   }
 }
 
 std::string type_name(int type) {
   static const std::map<int, std::string> names = {
-      {2, "3-node triangle"},        {3, "4-node quadrangle"},   {4, "4-node tetrahedron"},
-      {5, "8-node hexahedron"},      {6, "6-node prism"},         {7, "5-node pyramid"},
-      {9, "6-node triangle"},        {11, "10-node tetrahedron"}, {12, "27-node hexahedron"},
-      {16, "8-node quadrangle"},     {17, "20-node hexahedron"},  {21, "10-node triangle"},
-      {26, "4-node line"},           {36, "16-node quadrangle"}};
+      {2, "3-node triangle"},    {3, "4-node quadrangle"},    {4, "4-node tetrahedron"},
+      {5, "8-node hexahedron"},  {6, "6-node prism"},         {7, "5-node pyramid"},
+      {9, "6-node triangle"},    {11, "10-node tetrahedron"}, {12, "27-node hexahedron"},
+      {16, "8-node quadrangle"}, {17, "20-node hexahedron"},  {21, "10-node triangle"},
+      {26, "4-node line"},       {36, "16-node quadrangle"}};
   const auto it = names.find(type);
   return it == names.end() ? "unknown type" : it->second;
 }
@@ -206,15 +212,17 @@ Mesh read_gmsh(const std::string& path) {
           lex.fail("expected a quoted physical name, found '" + q + "'");
         const std::string pname = q.substr(1, q.size() - 2);
         if (pname == "all")
-          lex.fail("the physical group name \"all\" is reserved (the reader defines the sets \"all\" for "
-                   "the whole mesh); rename the group");
+          lex.fail(
+              "the physical group name \"all\" is reserved (the reader defines the sets \"all\" for "
+              "the whole mesh); rename the group");
         if (pname.empty()) lex.fail("empty physical name for tag " + std::to_string(tag));
         physical_names[{dim, tag}] = pname;
       }
       lex.expect("$EndPhysicalNames");
     } else if (name == "Entities") {
       long long counts[4];
-      for (int d = 0; d < 4; ++d) counts[d] = lex.next_count("the number of entities of dimension " + std::to_string(d));
+      for (int d = 0; d < 4; ++d)
+        counts[d] = lex.next_count("the number of entities of dimension " + std::to_string(d));
       for (int d = 0; d < 4; ++d)
         for (long long i = 0; i < counts[d]; ++i) {
           const int tag = lex.next_small_int("an entity tag");
@@ -241,7 +249,8 @@ Mesh read_gmsh(const std::string& path) {
         lex.next_int("the entity tag of a node block");
         const long long parametric = lex.next_int("the parametric flag");
         const long long n = lex.next_count("the number of nodes in a block");
-        if (dim < 0 || dim > 3) lex.fail("node block entity dimension " + std::to_string(dim) + " is not 0..3");
+        if (dim < 0 || dim > 3)
+          lex.fail("node block entity dimension " + std::to_string(dim) + " is not 0..3");
         if (parametric != 0 && parametric != 1)
           lex.fail("the parametric flag must be 0 or 1, found " + std::to_string(parametric));
         tags.clear();
@@ -292,7 +301,8 @@ Mesh read_gmsh(const std::string& path) {
           blk.lines.push_back(lex.line());
           for (int k = 0; k < npe; ++k) {
             const long long t = lex.next_int("an element node tag");
-            if (!node_xyz.count(t)) lex.fail("element node tag " + std::to_string(t) + " is not defined in $Nodes");
+            if (!node_xyz.count(t))
+              lex.fail("element node tag " + std::to_string(t) + " is not defined in $Nodes");
             blk.node_tags.push_back(t);
           }
         }
@@ -319,8 +329,9 @@ Mesh read_gmsh(const std::string& path) {
   std::sort(used.begin(), used.end());
   used.erase(std::unique(used.begin(), used.end()), used.end());
   if (used.empty())
-    lex.fail("no 9-node quadrangles (type 10) in the file; generate the surface mesh with 'gmsh -2 -order 2', "
-             "Mesh.SecondOrderIncomplete = 0 and Mesh.RecombineAll = 1");
+    lex.fail(
+        "no 9-node quadrangles (type 10) in the file; generate the surface mesh with 'gmsh -2 -order 2', "
+        "Mesh.SecondOrderIncomplete = 0 and Mesh.RecombineAll = 1");
   std::unordered_map<long long, int> index;
   Mesh mesh;
   for (long long t : used) {

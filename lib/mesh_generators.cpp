@@ -63,7 +63,9 @@ void require_int_nodes(const std::string& gen, std::int64_t nodes) {
 }
 
 // (1 - t) a + t b: returns a at t = 0 and b at t = 1 exactly (boundary coordinates are exact).
-double lerp(double a, double b, double t) { return (1.0 - t) * a + t * b; }
+double lerp(double a, double b, double t) {
+  return (1.0 - t) * a + t * b;
+}
 
 // cos and sin of an angle in degrees, exact at multiples of 90 deg so that nodes on the symmetry
 // planes, the equator and the axes have exact zero coordinates.
@@ -130,8 +132,8 @@ Mesh make_rectangle(double a, double b, int nx, int ny, double x0, double y0) {
   // I runs along +X (xi), J along +Y (eta): X,xi x X,eta = +Z, the documented normal.
   for (int J = 0; J < nj; ++J)
     for (int I = 0; I < ni; ++I)
-      m.X[id(I, J)] = Vec3(lerp(x0, x0 + a, double(I) / (ni - 1)), lerp(y0, y0 + b, double(J) / (nj - 1)),
-                           0.0);
+      m.X[id(I, J)] =
+          Vec3(lerp(x0, x0 + a, double(I) / (ni - 1)), lerp(y0, y0 + b, double(J) / (nj - 1)), 0.0);
   add_grid_elements(m, nx, ny, id);
 
   auto& left = m.node_sets["left"];
@@ -338,8 +340,8 @@ Mesh make_hemisphere(double radius, double hole_deg, bool quarter, int n) {
   if (!(std::isfinite(hole_deg) && hole_deg > 0.0 && hole_deg < 90.0))
     bad_parameter(gen, "parameter 'hole_deg' = " + str(hole_deg) +
                            " is invalid; it must lie in (0, 90) degrees (a closed pole is not supported)");
-  const int n_phi_el = quarter ? n : 4 * n;                 // elements around
-  const std::int64_t NI64 = 2 * static_cast<std::int64_t>(n) + 1;  // nodes along chi
+  const int n_phi_el = quarter ? n : 4 * n;                                               // elements around
+  const std::int64_t NI64 = 2 * static_cast<std::int64_t>(n) + 1;                         // nodes along chi
   const std::int64_t NJ64 = 2 * static_cast<std::int64_t>(n_phi_el) + (quarter ? 1 : 0);  // nodes along phi
   require_int_nodes(gen, NI64 * NJ64);
   const int ni = static_cast<int>(NI64), nj = static_cast<int>(NJ64);

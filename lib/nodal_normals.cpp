@@ -63,7 +63,9 @@ void check_connectivity(const Mesh& mesh, const char* fn) {
 
 // Reversed element: corners (1,2,3,4) -> (1,4,3,2); this swaps xi and eta, so mid-sides
 // (5,6,7,8) -> (8,7,6,5) and the centre stays.
-Quad9 reversed(const Quad9& q) { return {q[0], q[3], q[2], q[1], q[7], q[6], q[5], q[4], q[8]}; }
+Quad9 reversed(const Quad9& q) {
+  return {q[0], q[3], q[2], q[1], q[7], q[6], q[5], q[4], q[8]};
+}
 
 }  // namespace
 

@@ -15,7 +15,9 @@ namespace shelldyn {
 namespace {
 
 // Sparse, non-contiguous node tags for the 5 x 3 half-cell grid of the 2 x 1 plate [0,2] x [0,1].
-long long tag(int i, int j) { return 100 + 7 * (j * 5 + i); }
+long long tag(int i, int j) {
+  return 100 + 7 * (j * 5 + i);
+}
 constexpr int kDI[9] = {0, 2, 2, 0, 1, 2, 1, 0, 1};
 constexpr int kDJ[9] = {0, 0, 2, 2, 0, 1, 2, 1, 1};
 
@@ -27,11 +29,11 @@ std::string valid_msh() {
      << "$PhysicalNames\n3\n0 1 \"A\"\n1 2 \"left edge\"\n2 3 \"plate_left\"\n$EndPhysicalNames\n"
      << "$Comments\nthis section is unknown to the reader and must be skipped\n$EndComments\n"
      << "$Entities\n2 1 2 0\n"
-     << "1 1 0 0 1 1\n"                      // point 1 at (1,0,0), physical 1
-     << "2 9 9 9 0\n"                        // point 2, no physical group
-     << "1 0 0 0 0 1 0 1 2 2 1 -2\n"         // curve 1, physical 2, bounded by points 1, -2
-     << "1 0 0 0 1 1 0 1 3 1 1\n"            // surface 1, physical 3
-     << "2 1 0 0 2 1 0 1 7 1 1\n"            // surface 2, physical 7 (unnamed)
+     << "1 1 0 0 1 1\n"               // point 1 at (1,0,0), physical 1
+     << "2 9 9 9 0\n"                 // point 2, no physical group
+     << "1 0 0 0 0 1 0 1 2 2 1 -2\n"  // curve 1, physical 2, bounded by points 1, -2
+     << "1 0 0 0 1 1 0 1 3 1 1\n"     // surface 1, physical 3
+     << "2 1 0 0 2 1 0 1 7 1 1\n"     // surface 2, physical 7 (unnamed)
      << "$EndEntities\n";
   os << "$Nodes\n3 16 5 " << tag(4, 2) << "\n";
   os << "0 1 0 1\n" << tag(2, 0) << "\n1 0 0\n";
@@ -127,7 +129,8 @@ TEST(GmshReader, RejectsUnsupportedElementTypesWithHint) {
   const std::string base = valid_msh();
   // Quad4 (type 3) and tri6 (type 9) blocks: the error is at the block header.
   const std::string quad4 = replace_once(base, "2 2 10 1\n", "2 2 3 1\n");
-  expect_rejected("quad4", quad4, line_of(quad4, "2 2 3 1\n"), "element type 3 (4-node quadrangle) is not supported");
+  expect_rejected("quad4", quad4, line_of(quad4, "2 2 3 1\n"),
+                  "element type 3 (4-node quadrangle) is not supported");
   expect_rejected("quad4_hint", quad4, line_of(quad4, "2 2 3 1\n"), "gmsh -2 -order 2");
   const std::string tri6 = replace_once(base, "2 1 10 1\n", "2 1 9 1\n");
   expect_rejected("tri6", tri6, line_of(tri6, "2 1 9 1\n"), "only 9-node quadrangles (type 10)");
@@ -139,13 +142,16 @@ TEST(GmshReader, RejectsTruncatedSections) {
   // Cut in the middle of the surface node coordinates of $Nodes.
   const std::string cut = base.substr(0, base.find("1.5 0.5 0"));
   const int last_line = static_cast<int>(std::count(cut.begin(), cut.end(), '\n'));
-  expect_rejected("truncated_nodes", cut, last_line, "unexpected end of file while reading a node coordinate in section $Nodes");
+  expect_rejected("truncated_nodes", cut, last_line,
+                  "unexpected end of file while reading a node coordinate in section $Nodes");
   // Missing $EndNodes: the next section header appears where the end marker is expected.
   const std::string no_end = replace_once(base, "$EndNodes\n", "");
-  expect_rejected("no_end_nodes", no_end, line_of(no_end, "$Elements"), "expected '$EndNodes' in section $Nodes, found '$Elements'");
+  expect_rejected("no_end_nodes", no_end, line_of(no_end, "$Elements"),
+                  "expected '$EndNodes' in section $Nodes, found '$Elements'");
   // Unknown section without its end marker.
   const std::string open_unknown = replace_once(base, "$EndComments\n", "");
-  expect_rejected("open_unknown", open_unknown, static_cast<int>(std::count(base.begin(), base.end(), '\n')) - 1,
+  expect_rejected("open_unknown", open_unknown,
+                  static_cast<int>(std::count(base.begin(), base.end(), '\n')) - 1,
                   "section $Comments (started at line " + std::to_string(line_of(base, "$Comments")) +
                       ") has no $EndComments");
 }
@@ -153,13 +159,15 @@ TEST(GmshReader, RejectsTruncatedSections) {
 TEST(GmshReader, RejectsUndefinedNodesDuplicatesBadNumbersAndMissingFile) {
   const std::string base = valid_msh();
   const std::string undefined = replace_once(base, "\n30 ", "\n30 99999 ");
-  expect_rejected("undefined", undefined, line_of(undefined, "\n30 ") + 1, "element node tag 99999 is not defined");
+  expect_rejected("undefined", undefined, line_of(undefined, "\n30 ") + 1,
+                  "element node tag 99999 is not defined");
   const std::string dup = replace_once(base, "0 2 0 1\n5\n", "0 2 0 1\n" + std::to_string(tag(2, 0)) + "\n");
   expect_rejected("duplicate", dup, line_of(dup, "9 9 9\n"), "is defined twice");
   const std::string nan = replace_once(base, "\n1 0 0\n", "\n1 nan 0\n");
   expect_rejected("nan", nan, line_of(nan, "1 nan 0"), "is not finite");
   const std::string word = replace_once(base, "4 4 1 40", "4 four 1 40");
-  expect_rejected("word", word, line_of(word, "4 four 1 40"), "expected an integer for the number of elements");
+  expect_rejected("word", word, line_of(word, "4 four 1 40"),
+                  "expected an integer for the number of elements");
   const std::string reserved = replace_once(base, "\"plate_left\"", "\"all\"");
   expect_rejected("reserved", reserved, line_of(reserved, "\"all\""), "\"all\" is reserved");
   const std::string missing = ::testing::TempDir() + "shelldyn_does_not_exist.msh";

@@ -15,7 +15,9 @@ namespace {
 constexpr double kPi = 3.14159265358979323846;
 
 // The reversal documented in lib/nodal_normals.hpp: corners (1,2,3,4) -> (1,4,3,2).
-Quad9 reverse(const Quad9& q) { return {q[0], q[3], q[2], q[1], q[7], q[6], q[5], q[4], q[8]}; }
+Quad9 reverse(const Quad9& q) {
+  return {q[0], q[3], q[2], q[1], q[7], q[6], q[5], q[4], q[8]};
+}
 
 std::string message_of(const std::function<void()>& f) {
   try {
@@ -172,7 +174,8 @@ TEST(CheckOrientation, AcceptsStronglyCurvedElementsAndRejectsWrongInput) {
       m.X.emplace_back(0.5 * I, std::sin(psi), std::cos(psi));
     }
   auto id = [](int I, int J) { return 3 * J + I; };
-  m.elements.push_back({id(0, 0), id(2, 0), id(2, 2), id(0, 2), id(1, 0), id(2, 1), id(1, 2), id(0, 1), id(1, 1)});
+  m.elements.push_back(
+      {id(0, 0), id(2, 0), id(2, 2), id(0, 2), id(1, 0), id(2, 1), id(1, 2), id(0, 1), id(1, 1)});
   const auto p = initial_normals(m);
   EXPECT_NO_THROW(check_orientation(m, p));
   EXPECT_NE(message_of([&] { check_orientation(m, {}); }).find("got 0 normals"), std::string::npos);
