@@ -1,0 +1,314 @@
+#include "lib/discretization.hpp"
+
+#include "lib/gmsh_reader.hpp"
+#include "lib/mesh_generators.hpp"
+#include "lib/nodal_normals.hpp"
+
+#include <algorithm>
+#include <array>
+#include <functional>
+#include <cmath>
+#include <limits>
+#include <map>
+#include <set>
+#include <sstream>
+#include <stdexcept>
+#include <type_traits>
+#include <variant>
+
+namespace shelldyn {
+
+namespace {
+
+[[noreturn]] void fail(const std::string& where, const std::string& reason) {
+  throw std::runtime_error(where + ": " + reason);
+}
+
+std::string fmt(const Vec3& x) {
+  std::ostringstream os;
+  os.precision(10);
+  os << "(" << x.x() << ", " << x.y() << ", " << x.z() << ")";
+  return os.str();
+}
+
+std::string available_sets(const Mesh& mesh) {
+  std::string out;
+  for (const auto& [name, nodes] : mesh.node_sets) out += (out.empty() ? "" : ", ") + name;
+  return out;
+}
+
+const std::vector<int>& find_set(const Mesh& mesh, const std::string& name, const std::string& where) {
+  auto it = mesh.node_sets.find(name);
+  if (it == mesh.node_sets.end())
+    fail(where, "unknown set '" + name + "' (available: " + available_sets(mesh) +
+                    "; define it under 'sets:')");
+  return it->second;
+}
+
+// Adds the case's sets to mesh.node_sets. Unions may refer to sets defined later in the file, so sets
+// are resolved on demand with a depth-first walk that reports cycles.
+void resolve_case_sets(const CaseSpec& spec, Mesh& mesh, double mesh_size) {
+  std::map<std::string, const SetSpec*> pending;
+  for (const SetSpec& s : spec.sets) {
+    if (mesh.node_sets.count(s.name))
+      fail(s.where, "the mesh already has a node set '" + s.name + "' (choose another name)");
+    pending[s.name] = &s;
+  }
+  std::set<std::string> in_progress;
+  const int n = mesh.num_nodes();
+
+  std::function<void(const SetSpec&)> resolve = [&](const SetSpec& s) {
+    std::vector<int> nodes;
+    switch (s.kind) {
+      case SetSpec::Kind::Point: {
+        const double tol = s.tol >= 0.0 ? s.tol : 1e-6 * mesh_size;
+        int best = -1;
+        double best_d = std::numeric_limits<double>::infinity();
+        for (int i = 0; i < n; ++i) {
+          const double d = (mesh.X[static_cast<size_t>(i)] - s.point).norm();
+          if (d < best_d) best_d = d, best = i;
+        }
+        if (best < 0 || best_d > tol) {
+          std::ostringstream os;
+          os << "no node within tol = " << tol << " of the point " << fmt(s.point);
+          if (best >= 0)
+            os << "; the nearest is node " << best << " at " << fmt(mesh.X[static_cast<size_t>(best)])
+               << ", distance " << best_d;
+          os << " (correct the point or set 'tol')";
+          fail(s.where + ".point", os.str());
+        }
+        nodes.push_back(best);
+        break;
+      }
+      case SetSpec::Kind::Box: {
+        // Round-off tolerance, so that a box drawn exactly through a row of nodes catches it.
+        const double eps = 1e-9 * mesh_size;
+        for (int i = 0; i < n; ++i) {
+          const Vec3& x = mesh.X[static_cast<size_t>(i)];
+          if (((x - s.box_min).array() >= -eps).all() && ((s.box_max - x).array() >= -eps).all()) nodes.push_back(i);
+        }
+        if (nodes.empty())
+          fail(s.where + ".box", "empty set: no node lies inside the box " + fmt(s.box_min) + " - " + fmt(s.box_max) +
+                                     " (enlarge the box)");
+        break;
+      }
+      case SetSpec::Kind::Nodes:
+        for (int i : s.nodes) {
+          if (i >= n)
+            fail(s.where + ".nodes", "node index " + std::to_string(i) + " is out of range (the mesh has " +
+                                         std::to_string(n) + " nodes, indices are 0-based)");
+          nodes.push_back(i);
+        }
+        break;
+      case SetSpec::Kind::Union:
+        for (const std::string& member : s.members) {
+          if (!mesh.node_sets.count(member)) {
+            auto it = pending.find(member);
+            if (it == pending.end()) find_set(mesh, member, s.where + ".union");  // throws: unknown set
+            if (in_progress.count(member))
+              fail(s.where + ".union", "set '" + member + "' is part of a cycle of unions (break the cycle)");
+            in_progress.insert(member);
+            resolve(*it->second);
+            in_progress.erase(member);
+          }
+          const auto& m = mesh.node_sets.at(member);
+          nodes.insert(nodes.end(), m.begin(), m.end());
+        }
+        break;
+    }
+    std::sort(nodes.begin(), nodes.end());
+    nodes.erase(std::unique(nodes.begin(), nodes.end()), nodes.end());
+    mesh.node_sets[s.name] = std::move(nodes);
+  };
+
+  for (const SetSpec& s : spec.sets) {
+    if (mesh.node_sets.count(s.name)) continue;  // already resolved as a member of a union
+    in_progress.insert(s.name);
+    resolve(s);
+    in_progress.erase(s.name);
+  }
+}
+
+// Consistent nodal weights of a uniform line load on the quadratic edges that lie entirely in
+// `nodes` (element.md §4.1 shape functions restricted to an edge): w_k = ∫ N_k |dX/ds| ds, normalised
+// to sum 1. A straight edge with a centred mid-node gets 1/6, 4/6, 1/6 of its length share.
+std::map<int, double> edge_weights(const Mesh& mesh, const std::vector<int>& nodes, const std::string& where) {
+  static const int kEdges[4][3] = {{0, 4, 1}, {1, 5, 2}, {2, 6, 3}, {3, 7, 0}};  // corner, mid, corner
+  // 5-point Gauss–Legendre: exact for straight edges (polynomial degree 2) and accurate for curved ones.
+  static const double gs[5] = {-0.9061798459386640, -0.5384693101056831, 0.0, 0.5384693101056831,
+                               0.9061798459386640};
+  static const double gw[5] = {0.2369268850561891, 0.4786286704993665, 0.5688888888888889, 0.4786286704993665,
+                               0.2369268850561891};
+  const std::set<int> in(nodes.begin(), nodes.end());
+  std::set<std::array<int, 3>> done;
+  std::map<int, double> w;
+  double total = 0.0;
+  for (const Quad9& el : mesh.elements) {
+    for (const auto& e : kEdges) {
+      const int a = el[static_cast<size_t>(e[0])], m = el[static_cast<size_t>(e[1])], b = el[static_cast<size_t>(e[2])];
+      if (!in.count(a) || !in.count(m) || !in.count(b)) continue;
+      if (!done.insert({std::min(a, b), m, std::max(a, b)}).second) continue;  // shared edge: count once
+      const Vec3 &Xa = mesh.X[static_cast<size_t>(a)], &Xm = mesh.X[static_cast<size_t>(m)],
+                 &Xb = mesh.X[static_cast<size_t>(b)];
+      for (int g = 0; g < 5; ++g) {
+        const double s = gs[g];
+        const double Na = 0.5 * s * (s - 1.0), Nm = 1.0 - s * s, Nb = 0.5 * s * (s + 1.0);
+        const Vec3 dX = (s - 0.5) * Xa - 2.0 * s * Xm + (s + 0.5) * Xb;
+        const double jw = dX.norm() * gw[g];
+        w[a] += Na * jw, w[m] += Nm * jw, w[b] += Nb * jw;
+        total += jw;
+      }
+    }
+  }
+  if (w.empty() || !(total > 0.0))
+    fail(where, "distribution edge_total needs element edges whose 3 nodes all belong to the set; there are none "
+                "(use a set along an edge, or distribution: per_node)");
+  for (auto& [node, value] : w) value /= total;
+  return w;
+}
+
+}  // namespace
+
+Mesh build_mesh(const CaseSpec& spec) {
+  try {
+    return std::visit(
+        [](const auto& m) -> Mesh {
+          using T = std::decay_t<decltype(m)>;
+          if constexpr (std::is_same_v<T, RectangleMeshSpec>)
+            return make_rectangle(m.a, m.b, m.nx, m.ny, m.x0, m.y0);
+          else if constexpr (std::is_same_v<T, CellUnionMeshSpec>)
+            return make_cell_union(m.cells, m.cell);
+          else if constexpr (std::is_same_v<T, CylindricalPanelMeshSpec>)
+            return make_cylindrical_panel(m.radius, m.angle, m.length, m.n_arc, m.n_axial);
+          else if constexpr (std::is_same_v<T, HemisphereMeshSpec>)
+            return make_hemisphere(m.radius, m.hole_deg, m.quarter, m.n);
+          else
+            return read_gmsh(m.path);
+        },
+        spec.mesh);
+  } catch (const std::exception& e) {
+    fail(spec.mesh_where, e.what());
+  }
+}
+
+Discretization build_discretization(const CaseSpec& spec) {
+  Discretization d;
+  d.mesh = build_mesh(spec);
+  Mesh& mesh = d.mesh;
+  const int n = mesh.num_nodes();
+  try {
+    orient_consistently(mesh);
+    d.normals = initial_normals(mesh);
+    check_orientation(mesh, d.normals);
+    d.surface_area = surface_area(mesh);
+  } catch (const std::exception& e) {
+    fail(spec.mesh_where, e.what());
+  }
+  d.charts.reserve(static_cast<size_t>(n));
+  for (const Vec3& p : d.normals) d.charts.push_back(select_chart(p));
+
+  Vec3 lo = mesh.X.front(), hi = mesh.X.front();
+  for (const Vec3& x : mesh.X) lo = lo.cwiseMin(x), hi = hi.cwiseMax(x);
+  d.mesh_size = (hi - lo).norm();
+  d.total_mass = spec.material.rho * spec.material.thickness * d.surface_area;
+
+  resolve_case_sets(spec, mesh, d.mesh_size);
+
+  // Boundary conditions (element.md §2.3 item 2): recorded by meaning, resolved for the initial charts.
+  d.dofs = DofMap(n);
+  for (const auto& bc : spec.boundary_conditions)
+    for (int node : find_set(mesh, bc.set, bc.where + ".set"))
+      for (Fix f : bc.fix) d.dofs.fix(node, f);
+  try {
+    d.dofs.resolve(d.charts);
+  } catch (const std::exception& e) {
+    fail(spec.boundary_conditions.empty() ? spec.source : spec.boundary_conditions.front().where, e.what());
+  }
+
+  // Initial velocity: rigid-body field v = v0 + ω × (X − about), ṗ = ω × p (benchmarks.md §6).
+  d.initial_velocity = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(n) * kDofsPerNode);
+  const InitialVelocitySpec& iv = spec.initial_velocity;
+  if (iv.given) {
+    Vec3 about = iv.about;
+    if (iv.about_centroid) {
+      about.setZero();
+      for (const Vec3& x : mesh.X) about += x;
+      about /= n;
+    }
+    const double scale = iv.translation.norm() + iv.angular.norm() * std::max(d.mesh_size, 1.0);
+    for (int i = 0; i < n; ++i) {
+      const size_t si = static_cast<size_t>(i);
+      const Vec3 v = iv.translation + iv.angular.cross(mesh.X[si] - about);
+      const Eigen::Vector2d qdot = chart_coordinates(iv.angular.cross(d.normals[si]), d.charts[si]);
+      const Eigen::Index base = static_cast<Eigen::Index>(DofMap::dof(i, 0));
+      d.initial_velocity.segment<3>(base) = v;
+      d.initial_velocity.segment<2>(base + 3) = qdot;
+    }
+    // A prescribed DOF cannot start moving: refuse instead of silently zeroing the user's field.
+    for (Index dof : d.dofs.constrained_dofs()) {
+      const double value = d.initial_velocity[static_cast<Eigen::Index>(dof)];
+      if (std::abs(value) > 1e-12 * scale) {
+        std::ostringstream os;
+        os << "the initial velocity is " << value << " at DOF " << dof % kDofsPerNode << " of node "
+           << dof / kDofsPerNode << ", which a boundary condition fixes (remove the condition or change the velocity)";
+        fail(iv.where, os.str());
+      }
+    }
+  }
+
+  // Loads.
+  d.loads_end = 0.0;
+  for (const LoadSpec& l : spec.loads) {
+    const std::vector<int>& nodes = find_set(mesh, l.set, l.where + ".set");
+    const Vec3 vec = l.amplitude * l.direction;
+    if (l.distribution == LoadDistribution::PerNode) {
+      for (int node : nodes) d.loads.push_back({node, l.type, vec, l.function});
+    } else {
+      for (const auto& [node, w] : edge_weights(mesh, nodes, l.where + ".distribution"))
+        d.loads.push_back({node, l.type, w * vec, l.function});
+    }
+    d.loads_end = std::max(d.loads_end, l.function.end_of_support());
+  }
+
+  // Monitors.
+  for (const MonitorSpec& m : spec.monitors) {
+    const std::vector<int>& nodes = find_set(mesh, m.set, m.where + ".set");
+    if (nodes.size() != 1)
+      fail(m.where + ".set", "set '" + m.set + "' has " + std::to_string(nodes.size()) +
+                                 " nodes, a monitor needs exactly one (define a set with 'point:')");
+    if (m.quantity == MonitorQuantity::Ur &&
+        mesh.X[static_cast<size_t>(nodes[0])].norm() <= 1e-12 * std::max(d.mesh_size, 1.0))
+      fail(m.where + ".quantity", "ur is undefined at a node at the origin (use ux, uy or uz)");
+    d.monitors.push_back({m.name, nodes[0], m.quantity});
+  }
+  return d;
+}
+
+double monitor_value(const Monitor& m, const Mesh& mesh, const Eigen::VectorXd& u, const Eigen::VectorXd& v,
+                     const std::vector<DirectorChart>& charts) {
+  const Eigen::Index base = static_cast<Eigen::Index>(DofMap::dof(m.node, 0));
+  const int q = static_cast<int>(m.quantity);
+  switch (m.quantity) {
+    case MonitorQuantity::Ux:
+    case MonitorQuantity::Uy:
+    case MonitorQuantity::Uz:
+      return u[base + q - static_cast<int>(MonitorQuantity::Ux)];
+    case MonitorQuantity::Ur: {
+      const Vec3& X = mesh.X[static_cast<size_t>(m.node)];
+      return u.segment<3>(base).dot(X) / X.norm();
+    }
+    case MonitorQuantity::Px:
+    case MonitorQuantity::Py:
+    case MonitorQuantity::Pz: {
+      const Eigen::Vector2d qn = u.segment<2>(base + 3);
+      return director(qn, charts[static_cast<size_t>(m.node)])[q - static_cast<int>(MonitorQuantity::Px)];
+    }
+    case MonitorQuantity::Vx:
+    case MonitorQuantity::Vy:
+    case MonitorQuantity::Vz:
+      return v[base + q - static_cast<int>(MonitorQuantity::Vx)];
+  }
+  return 0.0;
+}
+
+}  // namespace shelldyn

@@ -1,0 +1,66 @@
+// From a validated case (lib/case_file.hpp) to the discrete problem: mesh, initial normals and
+// director charts, node sets, constraints, initial velocity, nodal loads, monitors, mass.
+//
+// This is the mesh-dependent half of reading a case: set look-ups, load distribution and the initial
+// velocity field need the nodes. Errors are std::runtime_error carrying the case file's
+// "FILE:LINE: key.path" of the offending entry, e.g.
+//   "plate.yaml:31: loads[0].set: unknown set 'tip' (available: all, boundary, A, B)".
+// Units are those of the case file.
+#pragma once
+
+#include "elements/director.hpp"
+#include "lib/case_file.hpp"
+#include "lib/dof_map.hpp"
+#include "lib/mesh.hpp"
+#include "lib/time_function.hpp"
+
+#include <Eigen/Core>
+#include <string>
+#include <vector>
+
+namespace shelldyn {
+
+// A dead nodal load after distribution: the load vector (force, or moment vector) is
+// `vector * function(t)`, where `vector` already includes the amplitude and the distribution weight.
+struct DiscreteLoad {
+  int node = 0;
+  LoadType type = LoadType::Force;
+  Vec3 vector = Vec3::Zero();
+  TimeFunction function;
+};
+
+struct Monitor {
+  std::string name;
+  int node = 0;
+  MonitorQuantity quantity = MonitorQuantity::Ux;
+};
+
+struct Discretization {
+  // The mesh, consistently oriented (orient_consistently), with the case's sets added to
+  // mesh.node_sets next to the generator's / Gmsh's own sets.
+  Mesh mesh;
+  std::vector<Vec3> normals;          // initial unit nodal normals p_i0 (element.md §2.4)
+  std::vector<DirectorChart> charts;  // select_chart(p_i0) per node (element.md §2.3)
+  DofMap dofs{0};                     // boundary conditions recorded and resolved for `charts`
+  // 5 per node: [v_X, v_Y, v_Z, q̇_1, q̇_2] with v = translation + ω × (X − about), q̇ = S (ω × p_i0)
+  // (S = 2x3 selector of the chart's minor components n, m). Zero if the case has no initial velocity.
+  Eigen::VectorXd initial_velocity;
+  std::vector<DiscreteLoad> loads;
+  double loads_end = 0.0;             // all loads vanish for t >= loads_end (+inf if some never do; 0 if none)
+  std::vector<Monitor> monitors;
+  double surface_area = 0.0;
+  double total_mass = 0.0;            // rho * thickness * surface_area
+  double mesh_size = 0.0;             // diagonal of the bounding box of the nodes
+};
+
+Discretization build_discretization(const CaseSpec& spec);
+
+// The mesh of a case alone (generated or read), before orientation; errors carry the mesh's location.
+Mesh build_mesh(const CaseSpec& spec);
+
+// Value of a monitor at a state given by the global vectors u = [d, q] and v = u̇ (5 per node) and
+// the current charts: ux..uz = d, ur = d·X0/|X0|, px..pz = p(q), vx..vz = ḋ.
+double monitor_value(const Monitor& m, const Mesh& mesh, const Eigen::VectorXd& u, const Eigen::VectorXd& v,
+                     const std::vector<DirectorChart>& charts);
+
+}  // namespace shelldyn
