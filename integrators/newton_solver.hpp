@@ -130,7 +130,7 @@ class NewtonSolver {
     int residual_evals = 0;  // real calls of the Residual (cache hits not counted)
     int jacobian_evals = 0;  // calls of the Jacobian = linear-solver setups
     int factorizations = 0;  // numeric factorizations done by the linear solver in this solve()
-    double fnorm = 0;        // ‖fscale·F(u)‖∞ at the returned u
+    double fnorm = 0;        // ‖fscale·F(u)‖∞ at the returned u (NaN if F failed there)
     double energy_ratio = 1;  // last cc = E_{k-1}/E_0 (1 before the second iteration)
     int kinsol_flag = 0;     // flag of the last KINSol call (see header comment)
     StopReason stop_reason = StopReason::none;

@@ -171,6 +171,20 @@ TEST(NewtonSolver, ModifiedNewtonUsesFewerFactorizationsAndMoreIterations) {
   EXPECT_EQ(mod.linear_solver().stats().analyses, 1);
 }
 
+TEST(NewtonSolver, LineSearchVariantConverges) {
+  const Bratu b(24, 6.0);
+  NewtonOptions o;
+  o.line_search = true;
+  o.linear_solver = "klu";
+  NewtonSolver solver(b.pattern, o);
+  std::vector<double> u(b.n(), 0.0);
+  const auto r = solver.solve(u.data(), b.F(), b.J());
+  ASSERT_TRUE(r.converged) << r.message;
+  EXPECT_LE(b.max_residual(u), 1e-10);
+  EXPECT_NEAR(r.fnorm, b.max_residual(u), 1e-14);
+  EXPECT_LE(r.iterations, 8);
+}
+
 TEST(NewtonSolver, ContinuationKeepsOneAnalysisAcrossSixSolves) {
   const Bratu base(30, 1.0);
   NewtonOptions o;
