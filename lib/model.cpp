@@ -177,6 +177,22 @@ void Model::external(double t, const Eigen::VectorXd& u, const std::vector<Direc
   }
 }
 
+void Model::add_load_stiffness(double t, const Eigen::VectorXd& u, const std::vector<DirectorChart>& charts,
+                               SparseMatrix& K) const {
+  for (const auto& load : loads_) {
+    const double f = load.function(t);
+    if (f == 0.0 || load.kind != NodalLoad::Kind::Moment) continue;
+    const Eigen::Vector2d q = u.segment<2>(DofMap::dof(load.node, 3));
+    const DirectorChart& ch = charts[static_cast<size_t>(load.node)];
+    const Vec3 w = (f * load.vector).cross(shelldyn::director(q, ch));
+    const Eigen::Matrix2d dF = w[ch.l] * director_d2pl(q, ch);  // symmetric part of ∂(A1ᵀ w)/∂q
+    for (int a = 0; a < 2; ++a)
+      for (int b = 0; b < 2; ++b)
+        K.values[static_cast<size_t>(assembler_.find(DofMap::dof(load.node, 3 + a), DofMap::dof(load.node, 3 + b)))] -=
+            dF(a, b);
+  }
+}
+
 Invariants Model::invariants(const State& s) const {
   Invariants inv;
   std::vector<double> kinetic(elements_.size(), 0.0);

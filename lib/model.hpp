@@ -74,6 +74,12 @@ class Model {
                 double* Fm) const;
   // F_ext(t, q) (overwrites F). Moments depend on q through p and A1.
   void external(double t, const Eigen::VectorXd& u, const std::vector<DirectorChart>& charts, double* F) const;
+  // K += −sym(∂F_ext/∂q): the symmetric part of the load stiffness of dead moments (the curvature
+  // term (m × p)_l ∂²p_l/∂q∂q). The skew part A1ᵀ[m]×A1 is left out (it vanishes for moments normal to
+  // the plane the director turns in, e.g. the roll-up benchmark), so Newton may converge linearly
+  // for general 3-D moments. Forces are dead and contribute nothing.
+  void add_load_stiffness(double t, const Eigen::VectorXd& u, const std::vector<DirectorChart>& charts,
+                          SparseMatrix& K) const;
   Invariants invariants(const State& s) const;
 
   // Current director of node i.
