@@ -218,7 +218,17 @@ Discretization build_discretization(const CaseSpec& spec) {
   d.dofs = DofMap(n);
   for (const auto& bc : spec.boundary_conditions)
     for (int node : find_set(mesh, bc.set, bc.where + ".set"))
-      for (Fix f : bc.fix) d.dofs.fix(node, f);
+      for (Fix f : bc.fix) {
+        // A fixed director component must be a minor one (a symmetry plane has p_k = 0); checked
+        // here as well as in DofMap::resolve so that the message can point at the case-file entry.
+        const int k = f == Fix::Px ? 0 : f == Fix::Py ? 1 : f == Fix::Pz ? 2 : -1;
+        if (k >= 0 && d.charts[static_cast<size_t>(node)].l == k)
+          fail(bc.where + ".fix", std::string("cannot fix ") + fix_name(f) + " at node " + std::to_string(node) +
+                                      ": it is the largest director component there (p = " +
+                                      fmt(d.normals[static_cast<size_t>(node)]) +
+                                      "); only components that are 0 on a symmetry plane can be fixed (use 'director' to clamp)");
+        d.dofs.fix(node, f);
+      }
   try {
     d.dofs.resolve(d.charts);
   } catch (const std::exception& e) {

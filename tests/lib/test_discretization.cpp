@@ -164,6 +164,8 @@ const BadSetup kBad[] = {
     {"velocity at a fixed DOF",
      "boundary_conditions:\n  - {set: left, fix: [ux]}\ninitial_velocity: {translation: [1, 0, 0]}\n",
      "plate.yaml:8: initial_velocity:", "fixes"},
+    {"fixing the dependent director component", "boundary_conditions:\n  - {set: left, fix: [px, pz]}\n",
+     "plate.yaml:7: boundary_conditions[0].fix:", "cannot fix pz"},
 };
 
 INSTANTIATE_TEST_SUITE_P(Discretization, BadDiscretization,
@@ -312,6 +314,28 @@ TEST(Discretization, GmshMeshWithPhysicalGroups) {
   double biggest = 0;
   for (const auto& l : d.loads) biggest = std::max(biggest, l.vector.x());
   EXPECT_NEAR(biggest, 2.0, 1e-14);
+}
+
+}  // namespace
+
+namespace {
+
+TEST(Discretization, SymmetryPlanesOnAQuarterHemisphere) {
+  const std::string text =
+      "mesh: {generator: hemisphere, radius: 10, hole_deg: 18, quarter: true, n: 2}\n"
+      "material: {E: 1, nu: 0.3, rho: 1, thickness: 0.04}\nintegrator: {name: x}\ntime: {dt: 1, t_end: 1}\n"
+      "boundary_conditions:\n  - {set: sym_y0, fix: [uy, py]}\n  - {set: sym_x0, fix: [ux, px]}\n";
+  const Discretization d = build_discretization(load_case_from_string(text, "quarter.yaml"));
+  const auto& y0 = d.mesh.node_sets.at("sym_y0");
+  const auto& x0 = d.mesh.node_sets.at("sym_x0");
+  EXPECT_EQ(y0.size(), 5u);
+  EXPECT_EQ(d.dofs.num_constrained(), static_cast<Index>(2 * (y0.size() + x0.size())));
+  for (int node : y0) {
+    EXPECT_TRUE(d.dofs.is_constrained(DofMap::dof(node, 1)));
+    const DirectorChart& ch = d.charts[static_cast<size_t>(node)];
+    // p_Y is stored in q_1 if n = Y, else in q_2 (m = Y); that entry must be constrained.
+    EXPECT_TRUE(d.dofs.is_constrained(DofMap::dof(node, ch.n == 1 ? 3 : 4)));
+  }
 }
 
 }  // namespace
