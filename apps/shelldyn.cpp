@@ -102,7 +102,12 @@ void print_summary(std::ostream& out, const CaseSpec& c, const Discretization& d
                                        : std::string("none (at rest)"))
                           << "\n";
   row("loads") << c.loads.size() << " entries -> " << d.loads.size() << " nodal loads";
-  if (!c.loads.empty()) out << "; all vanish for t >= " << d.loads_end;
+  if (!c.loads.empty()) {
+    if (std::isinf(d.loads_end))
+      out << "; some never vanish";
+    else
+      out << "; all vanish for t >= " << d.loads_end;
+  }
   out << "\n";
   for (const auto& l : c.loads) {
     row("") << l.set << ": " << load_type_name(l.type) << " " << l.amplitude << " * " << vec_text(l.direction)
