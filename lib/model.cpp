@@ -1,5 +1,7 @@
 #include "lib/model.hpp"
 
+#include <algorithm>
+#include <cmath>
 #include <exception>
 #include <mutex>
 #include <stdexcept>
@@ -213,6 +215,22 @@ Invariants Model::invariants(const State& s) const {
   }
   inv.strain = internal(s.u, s.charts, nullptr, nullptr);
   return inv;
+}
+
+double Model::loads_end() const {
+  double end = 0.0;
+  for (const auto& load : loads_) end = std::max(end, load.function.end_of_support());
+  return end;
+}
+
+double Model::chart_margin(const State& s) const {
+  double margin = 1.0;
+  for (int i = 0; i < mesh_.num_nodes(); ++i) {
+    const Vec3 p = director(s, i);
+    const DirectorChart& ch = s.charts[static_cast<size_t>(i)];
+    margin = std::min(margin, std::abs(p[ch.l]) - std::max(std::abs(p[ch.n]), std::abs(p[ch.m])));
+  }
+  return margin;
 }
 
 Vec3 Model::director(const State& s, int node) const {

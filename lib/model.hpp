@@ -15,6 +15,7 @@
 #include "lib/assembler.hpp"
 #include "lib/dof_map.hpp"
 #include "lib/mesh.hpp"
+#include "lib/semi_discrete_system.hpp"
 #include "lib/sparse_matrix.hpp"
 #include "lib/state.hpp"
 #include "lib/time_function.hpp"
@@ -34,14 +35,7 @@ struct NodalLoad {
   TimeFunction function;
 };
 
-struct Invariants {
-  double kinetic = 0.0;   // ½ q̇ᵀ M(q) q̇  (§5.4)
-  double strain = 0.0;    // Σ U_e
-  Vec3 L = Vec3::Zero();  // linear momentum
-  Vec3 J = Vec3::Zero();  // angular momentum about the origin, director term included
-};
-
-class Model {
+class Model final : public SemiDiscreteSystem {
  public:
   // normals: initial unit nodal normals p_i0 (lib/nodal_normals.hpp). Throws if an element fails the
   // orientation check or the material is invalid (messages name the element).
@@ -52,42 +46,45 @@ class Model {
   const std::vector<Vec3>& normals() const { return normals_; }
   const ShellMaterial& material() const { return material_; }
   const Assembler& assembler() const { return assembler_; }
-  const DofMap& dofs() const { return dofs_; }
+  const DofMap& dofs() const override { return dofs_; }
   const std::vector<NodalLoad>& loads() const { return loads_; }
   const CR9Shell& element(int e) const { return elements_[static_cast<size_t>(e)]; }
-  Index num_dofs() const { return assembler_.num_dofs(); }
-  std::shared_ptr<const SparsePattern> pattern() const { return assembler_.pattern(); }
+  Index num_dofs() const override { return assembler_.num_dofs(); }
+  std::shared_ptr<const SparsePattern> pattern() const override { return assembler_.pattern(); }
   SparseMatrix make_matrix() const;  // zero matrix on the model's pattern
 
   // The reference state: t = 0, d = 0, q = minor components of p_i0 in freshly selected charts, v = a = 0.
-  State initial_state() const;
+  State initial_state() const override;
 
   // F_int(q), K = ∂F_int/∂q (exact, symmetric), returns V = Σ U_e. F or K may be null.
   double internal(const Eigen::VectorXd& u, const std::vector<DirectorChart>& charts, double* F,
-                  SparseMatrix* K) const;
+                  SparseMatrix* K) const override;
   // Strain-averaged force F*_int,mid and its symmetric tangent K_mid (spec/element.md §6.3); returns V(u_np1).
   double algorithmic_internal(const Eigen::VectorXd& u_n, const Eigen::VectorXd& u_np1,
                               const std::vector<DirectorChart>& charts, double alpha_f, double xi, double* F,
-                              SparseMatrix* K) const;
-  void mass(const Eigen::VectorXd& u, const std::vector<DirectorChart>& charts, SparseMatrix& M) const;
+                              SparseMatrix* K) const override;
+  void mass(const Eigen::VectorXd& u, const std::vector<DirectorChart>& charts, SparseMatrix& M) const override;
   void inertial(const Eigen::VectorXd& u, const Eigen::VectorXd& v, const std::vector<DirectorChart>& charts,
-                double* Fm) const;
+                double* Fm) const override;
   // F_ext(t, q) (overwrites F). Moments depend on q through p and A1.
-  void external(double t, const Eigen::VectorXd& u, const std::vector<DirectorChart>& charts, double* F) const;
+  void external(double t, const Eigen::VectorXd& u, const std::vector<DirectorChart>& charts,
+                double* F) const override;
   // K += −sym(∂F_ext/∂q): the symmetric part of the load stiffness of dead moments (the curvature
   // term (m × p)_l ∂²p_l/∂q∂q). The skew part A1ᵀ[m]×A1 is left out (it vanishes for moments normal to
   // the plane the director turns in, e.g. the roll-up benchmark), so Newton may converge linearly
   // for general 3-D moments. Forces are dead and contribute nothing.
   void add_load_stiffness(double t, const Eigen::VectorXd& u, const std::vector<DirectorChart>& charts,
-                          SparseMatrix& K) const;
-  Invariants invariants(const State& s) const;
+                          SparseMatrix& K) const override;
+  Invariants invariants(const State& s) const override;
+  double loads_end() const override;
 
   // Current director of node i.
   Vec3 director(const State& s, int node) const;
 
   // Re-selects director charts between increments (spec/element.md §2.3), converting u, v, a, and
   // re-resolves director constraints. Returns the number of nodes whose chart switched.
-  int rechart(State& s, double hysteresis = 1.0);
+  int rechart(State& s, double hysteresis = 1.0) override;
+  double chart_margin(const State& s) const override;
 
  private:
   void gather(int e, const Eigen::VectorXd& global, CR9Shell::Vec45& ue) const;
