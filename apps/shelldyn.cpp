@@ -17,6 +17,9 @@
 // Adding a subcommand (run, static, ...): write `add_<name>_command(CLI::App&, Action&)` next to
 // add_check_command: it registers its options and, in its callback, stores the action to run.
 // main() stays unchanged apart from one call.
+#include "integrators/integrator.hpp"
+#include "integrators/run_driver.hpp"
+#include "integrators/static_run.hpp"
 #include "integrators/sundials_info.hpp"
 #include "lib/case_file.hpp"
 #include "lib/discretization.hpp"
@@ -191,6 +194,87 @@ void add_check_command(CLI::App& app, Action& action, const std::string& command
   sub->callback([opts, &action] { action = [opts] { return run_check(*opts); }; });
 }
 
+// --- run ---------------------------------------------------------------------------------------------
+struct RunCommandOptions {
+  std::string case_path, out_dir, integrator, command;
+  std::vector<std::string> settings;  // key=value
+  double dt = 0.0, t_end = -1.0, output_every = 0.0;
+  int vtu_every = -1, threads = 0;
+  bool quiet = false;
+};
+
+std::pair<std::string, std::string> split_setting(const std::string& kv) {
+  const auto eq = kv.find('=');
+  if (eq == std::string::npos || eq == 0 || eq + 1 == kv.size())
+    throw std::invalid_argument("--set '" + kv + "': expected KEY=VALUE, e.g. --set rho_inf=0.8");
+  return {kv.substr(0, eq), kv.substr(eq + 1)};
+}
+
+int run_run(const RunCommandOptions& o) {
+  Problem problem = load_problem(o.case_path);
+  RunOptions ro;
+  ro.integrator = o.integrator;
+  for (const auto& kv : o.settings) ro.settings.push_back(split_setting(kv));
+  if (o.dt < 0.0) throw std::invalid_argument("--dt must be > 0 (got " + std::to_string(o.dt) + ")");
+  if (o.t_end < 0.0 && o.t_end != -1.0) throw std::invalid_argument("--t-end must be >= 0 (got " + std::to_string(o.t_end) + ")");
+  ro.dt = o.dt;
+  ro.t_end = o.t_end;
+  ro.output_interval = o.output_every;
+  ro.vtu_every = o.vtu_every;
+  ro.threads = o.threads;
+  ro.command = o.command;
+  ro.log = o.quiet ? nullptr : &std::cout;
+  const std::string integrator = o.integrator.empty() ? problem.spec.integrator.name : o.integrator;
+  ro.out_dir = o.out_dir.empty() ? (fs::path("results") / problem.spec.name / integrator).string() : o.out_dir;
+  std::cout << "shelldyn run: " << problem.spec.name << " with " << integrator << " -> " << ro.out_dir << std::endl;
+  const RunSummary s = run_dynamic(problem, ro);
+  print_run_summary(std::cout, s);
+  std::cout << "wrote " << ro.out_dir << "/history.csv, " << ro.out_dir << "/fields.pvd, " << ro.out_dir << "/run.json\n";
+  return 0;
+}
+
+void add_run_command(CLI::App& app, Action& action, const std::string& command) {
+  auto o = std::make_shared<RunCommandOptions>();
+  o->command = command;
+  std::string names;
+  for (const auto& [name, summary] : integrator_catalogue()) names += "\n  " + name + ": " + summary;
+  CLI::App* sub = app.add_subcommand("run", "Integrate a case in time and write history.csv, VTU/PVD and run.json");
+  sub->add_option("case", o->case_path, "Case file (YAML), e.g. apps/cases/flying-plate.yaml")->required();
+  sub->add_option("-o,--output", o->out_dir, "Result folder (default: results/<case>/<integrator>)");
+  sub->add_option("--integrator", o->integrator, "Integrator (default: the case's integrator.name):" + names);
+  sub->add_option("--set", o->settings, "Override an integrator setting, KEY=VALUE (repeatable), e.g. --set rho_inf=0.8");
+  sub->add_option("--dt", o->dt, "Time step (default: the case's time.dt)");
+  sub->add_option("--t-end", o->t_end, "End time (default: the case's time.t_end)");
+  sub->add_option("--output-every", o->output_every, "Output interval in time units (default: the case's time.output_interval)");
+  sub->add_option("--vtu-every", o->vtu_every, "Write a VTU every N output times; 0 disables (default: the case's output.vtu_every)");
+  sub->add_option("--threads", o->threads, "OpenMP threads for element loops (default: all cores)")->check(CLI::NonNegativeNumber);
+  sub->add_flag("-q,--quiet", o->quiet, "No progress lines");
+  sub->callback([o, &action] { action = [o] { return run_run(*o); }; });
+}
+
+// --- static ------------------------------------------------------------------------------------------
+int run_static_command(const CheckOptions& o) {
+  Problem problem = load_problem(o.case_path);
+  const std::string dir = o.out_dir.empty() ? (fs::path("results") / problem.spec.name / "static").string() : o.out_dir;
+  std::cout << "shelldyn static: " << problem.spec.name << " -> " << dir << std::endl;
+  StaticReport report;
+  const auto rows = run_static(problem, dir, &std::cout, &report);
+  std::cout << "summary: " << report.levels << " load levels, " << report.increments << " increments ("
+            << report.failed_attempts << " failed attempts), " << report.newton_iterations << " Newton iterations, "
+            << report.chart_switches << " director chart switches, " << report.wall_seconds << " s\n";
+  std::cout << "wrote " << dir << "/static.csv, " << dir << "/fields.pvd, " << dir << "/run.json\n";
+  return rows.empty() ? 1 : 0;
+}
+
+void add_static_command(CLI::App& app, Action& action, const std::string& command) {
+  auto opts = std::make_shared<CheckOptions>();
+  opts->command = command;
+  CLI::App* sub = app.add_subcommand("static", "Solve a static case by load stepping (integrator: static); write static.csv, VTU/PVD, run.json");
+  sub->add_option("case", opts->case_path, "Case file (YAML), e.g. apps/cases/sze-hemisphere.yaml")->required();
+  sub->add_option("-o,--output", opts->out_dir, "Result folder (default: results/<case>/static)");
+  sub->callback([opts, &action] { action = [opts] { return run_static_command(*opts); }; });
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -204,6 +288,8 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   Action action;
   add_check_command(app, action, command);
+  add_run_command(app, action, command);
+  add_static_command(app, action, command);
 
   try {
     app.parse(argc, argv);

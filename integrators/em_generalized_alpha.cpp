@@ -5,6 +5,7 @@
 #include "lib/linear_solver.hpp"
 
 #include <chrono>
+#include <cstdio>
 #include <cmath>
 #include <sstream>
 
@@ -70,11 +71,13 @@ class NewmarkFamily final : public Integrator {
     if (!(nopt_.energy_tol > 0.0) || nopt_.max_iters < 1 || nopt_.min_iters < 0 || max_cuts_ < 0 || hysteresis_ < 1.0)
       throw std::invalid_argument(name_ + ": need cc_tol > 0, max_iters >= 1, min_iters >= 0, max_cuts >= 0, hysteresis >= 1");
     resolved_ = s.resolved();
-    resolved_.insert(resolved_.begin(), {{"dt", std::to_string(dt_)},
-                                         {"alpha_m", std::to_string(p_.alpha_m)},
-                                         {"alpha_f", std::to_string(p_.alpha_f)},
-                                         {"beta", std::to_string(p_.beta)},
-                                         {"gamma", std::to_string(p_.gamma)}});
+    auto g = [](double x) {
+      char b[32];
+      std::snprintf(b, sizeof b, "%.10g", x);
+      return std::string(b);
+    };
+    resolved_.insert(resolved_.begin(), {{"dt", g(dt_)}, {"alpha_m", g(p_.alpha_m)}, {"alpha_f", g(p_.alpha_f)},
+                                         {"beta", g(p_.beta)}, {"gamma", g(p_.gamma)}});
   }
 
   std::string name() const override { return name_; }

@@ -9,7 +9,7 @@ namespace shelldyn {
 namespace {
 std::string format(double x) {
   std::ostringstream s;
-  s.precision(17);
+  s.precision(10);  // shortest faithful form of the usual inputs (1e-12, not 9.9999999999999998e-13)
   s << x;
   return s.str();
 }
