@@ -4,6 +4,8 @@
 #include <cmath>
 #include <exception>
 #include <mutex>
+
+#include <omp.h>
 #include <stdexcept>
 #include <string>
 
@@ -11,25 +13,33 @@ namespace shelldyn {
 namespace {
 
 // Runs body(e) for every element, colour by colour; elements of one colour share no node, so their
-// scatter operations never collide. The first exception thrown by any element is rethrown afterwards
-// (exceptions must not leave an OpenMP region).
+// scatter operations never collide. One parallel region for all colours (a barrier between colours);
+// small meshes run serially, where thread start-up and barriers cost more than the element work.
+// The first exception thrown by any element is rethrown afterwards (exceptions must not leave an
+// OpenMP region).
+constexpr int kMinElementsForThreads = 48;
+
 template <class Body>
 void for_each_element(const Assembler& assembler, const Body& body) {
   std::exception_ptr error;
   std::mutex error_mutex;
-  for (const auto& colour : assembler.colours()) {
-    const int count = static_cast<int>(colour.size());
-#pragma omp parallel for schedule(dynamic, 4)
-    for (int k = 0; k < count; ++k) {
-      try {
-        body(colour[static_cast<size_t>(k)]);
-      } catch (...) {
-        std::lock_guard<std::mutex> lock(error_mutex);
-        if (!error) error = std::current_exception();
+  const bool parallel = assembler.num_elements() >= kMinElementsForThreads && omp_get_max_threads() > 1;
+#pragma omp parallel if (parallel)
+  {
+    for (const auto& colour : assembler.colours()) {
+      const int count = static_cast<int>(colour.size());
+#pragma omp for schedule(dynamic, 2)
+      for (int k = 0; k < count; ++k) {
+        try {
+          body(colour[static_cast<size_t>(k)]);
+        } catch (...) {
+          std::lock_guard<std::mutex> lock(error_mutex);
+          if (!error) error = std::current_exception();
+        }
       }
     }
-    if (error) std::rethrow_exception(error);
   }
+  if (error) std::rethrow_exception(error);
 }
 
 double sum(const std::vector<double>& values) {
