@@ -17,6 +17,8 @@
 // Adding a subcommand (run, static, ...): write `add_<name>_command(CLI::App&, Action&)` next to
 // add_check_command: it registers its options and, in its callback, stores the action to run.
 // main() stays unchanged apart from one call.
+#include "apps/app_common.hpp"
+#include "integrators/compare.hpp"
 #include "integrators/integrator.hpp"
 #include "integrators/run_driver.hpp"
 #include "integrators/static_run.hpp"
@@ -275,6 +277,82 @@ void add_static_command(CLI::App& app, Action& action, const std::string& comman
   sub->callback([opts, &action] { action = [opts] { return run_static_command(*opts); }; });
 }
 
+
+// --- compare -----------------------------------------------------------------------------------------
+// `shelldyn compare CASE --integrators A,B:KEY=VALUE,... [--dt LIST] [--rtol LIST]`: the comparison
+// study of integrators/compare.hpp (spec syntax, sweeps, reference run and error measures are documented
+// there), then scripts/plot_compare.py. Exit 0 when every run completed, 3 when some failed (they are
+// rows with status "failed: ..." in summary.csv/summary.md), 1 for bad input.
+struct CompareCommandOptions {
+  std::string case_path, out_dir, reference, command;
+  std::vector<std::string> specs;
+  std::vector<double> dts, rtols;
+  double t_end = -1.0, output_every = 0.0;
+  int jobs = 2, threads = 0, vtu_every = 0;
+  bool no_plots = false;
+};
+
+int run_compare(const CompareCommandOptions& o) {
+  CompareOptions co;
+  co.case_path = o.case_path;
+  if (!fs::exists(co.case_path) && co.case_path.find('/') == std::string::npos)
+    co.case_path = app::find_case_file(co.case_path + (fs::path(co.case_path).extension() == ".yaml" ? "" : ".yaml"));
+  if (o.t_end < 0.0 && o.t_end != -1.0) throw std::invalid_argument("--t-end must be >= 0 (got " + std::to_string(o.t_end) + ")");
+  if (o.jobs < 1) throw std::invalid_argument("--jobs must be >= 1 (got " + std::to_string(o.jobs) + ")");
+  co.specs = o.specs;
+  co.dts = o.dts;
+  co.rtols = o.rtols;
+  co.t_end = o.t_end;
+  co.output_interval = o.output_every;
+  co.vtu_every = o.vtu_every;
+  co.jobs = o.jobs;
+  co.threads = o.threads;
+  co.reference = o.reference;
+  co.command = o.command;
+  co.log = &std::cout;
+  const std::string stem = fs::path(co.case_path).stem().string();
+  co.out_dir = o.out_dir.empty() ? (fs::path("results") / stem / "compare").string() : o.out_dir;
+  const auto runs = expand_compare_runs(co);  // bad specs fail here, before any folder exists
+  app::check_output_folder(co.out_dir);
+  std::cout << "shelldyn compare: " << stem << ", " << runs.size() << " runs, " << co.jobs << " at a time -> " << co.out_dir
+            << std::endl;
+  const CompareResult r = run_comparison(co);
+  size_t failed = 0;
+  for (const auto& row : r.rows) failed += row.ok ? 0 : 1;
+  std::cout << "wrote " << r.summary_csv << ", " << r.summary_md << " (" << r.rows.size() - failed << " complete, " << failed
+            << " failed; reference " << (r.reference.empty() ? std::string("none") : r.reference) << ")" << std::endl;
+  if (!o.no_plots && app::run_python_script(app::find_script("plot_compare.py"), {co.out_dir}, std::cout))
+    std::cout << "wrote " << co.out_dir << "/energy.png, momentum.png, work_precision.png" << std::endl;
+  return failed ? 3 : 0;
+}
+
+void add_compare_command(CLI::App& app, Action& action, const std::string& command) {
+  auto o = std::make_shared<CompareCommandOptions>();
+  o->command = command;
+  std::string names;
+  for (const auto& n : integrator_names()) names += (names.empty() ? "" : ", ") + n;
+  CLI::App* sub = app.add_subcommand(
+      "compare", "Run one case with several integrator settings (2 at a time); write summary.csv, summary.md and plots");
+  sub->add_option("case", o->case_path, "Case file (YAML), or a case name of apps/cases such as flying-plate")->required();
+  sub->add_option("--integrators", o->specs,
+                  "Comma-separated runs NAME[:KEY=VALUE...], e.g. em-galpha,galpha:rho_inf=0.8,em-galpha:dt=2e-3,"
+                  "ida-bdf:rtol=1e-8 (integrators: " + names + ")")
+      ->required()
+      ->delimiter(',');
+  sub->add_option("--dt", o->dts, "Comma-separated time steps: one run per dt for every fixed-step setting without its own dt")
+      ->delimiter(',');
+  sub->add_option("--rtol", o->rtols, "Comma-separated tolerances: one run per rtol for every adaptive setting without its own rtol")
+      ->delimiter(',');
+  sub->add_option("--t-end", o->t_end, "End time (default: the case's time.t_end)");
+  sub->add_option("--output-every", o->output_every, "Output interval (default: the case's)");
+  sub->add_option("--vtu-every", o->vtu_every, "VTU every N output times per run (default 0: none)")->check(CLI::NonNegativeNumber);
+  sub->add_option("-o,--output", o->out_dir, "Result folder (default: results/<case>/compare)");
+  sub->add_option("--jobs", o->jobs, "Runs at a time, each single-threaded when > 1 (default 2)");
+  sub->add_option("--threads", o->threads, "OpenMP threads per run when --jobs 1 (default: all cores)")->check(CLI::NonNegativeNumber);
+  sub->add_option("--reference", o->reference, "Label of the reference run for displacement errors (default: finest fixed-step run)");
+  sub->add_flag("--no-plots", o->no_plots, "Do not call scripts/plot_compare.py");
+  sub->callback([o, &action] { action = [o] { return run_compare(*o); }; });
+}
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -290,6 +368,7 @@ int main(int argc, char** argv) {
   add_check_command(app, action, command);
   add_run_command(app, action, command);
   add_static_command(app, action, command);
+  add_compare_command(app, action, command);
 
   try {
     app.parse(argc, argv);

@@ -13,6 +13,7 @@ PACKAGES=(
   libgtest-dev libgmock-dev            # unit tests
   libbenchmark-dev                     # performance programs
   python3 python3-meshio               # VTU round-trip check in the test suite
+  python3-matplotlib                   # plots of the apps and `shelldyn compare` (scripts/plot_*.py)
 )
 
 missing=()
