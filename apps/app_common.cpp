@@ -2,6 +2,7 @@
 
 #include "integrators/compare.hpp"
 #include "integrators/integrator.hpp"
+#include "integrators/integrator_settings.hpp"
 #include "integrators/run_driver.hpp"
 
 #include <Eigen/Dense>
@@ -292,6 +293,13 @@ int BenchmarkApp::run() {
   CaseSpec spec = load_case(case_path);
   if (modify_case) modify_case(spec);
   const std::string integrator = o_.integrator.empty() ? spec.integrator.name : o_.integrator;
+  {  // Check the integrator settings now (run_dynamic would, but only after building the model).
+    IntegratorSettings check = integrator == spec.integrator.name ? IntegratorSettings(spec.integrator)
+                                                                  : IntegratorSettings(integrator, {});
+    for (const auto& [k, v] : settings) check.set(k, v);
+    if (integrator == "static") throw std::invalid_argument("--integrator static: use `shelldyn static CASE`");
+    make_integrator(check, o_.dt > 0.0 ? o_.dt : spec.time.dt);
+  }
   auto overrides = settings;
   if (o_.dt > 0.0) overrides.emplace_back("dt", num(o_.dt));
   const std::string out_dir =
