@@ -1,0 +1,476 @@
+#include "integrators/arkode_integrators.hpp"
+
+#include "integrators/first_order_system.hpp"
+#include "integrators/sundials_support.hpp"
+#include "lib/assembler.hpp"
+
+#include <cstdio>  // arkode_butcher.h uses FILE without including it (stack.md §2.2)
+#include <arkode/arkode_arkstep.h>
+#include <arkode/arkode_butcher_dirk.h>
+#include <arkode/arkode_butcher_erk.h>
+
+#include <chrono>
+#include <cmath>
+#include <sstream>
+
+namespace shelldyn {
+namespace {
+
+struct ArkCounters {
+  long steps = 0, attempts = 0, fe = 0, fi = 0, newton = 0, setups = 0;
+};
+
+class ArkodeIntegrator final : public Integrator {
+ public:
+  ArkodeIntegrator(IntegratorSettings& s, double dt, bool implicit) : implicit_(implicit), dt_(dt) {
+    name_ = implicit ? "arkode-dirk" : "arkode-erk";
+    table_ = s.get("table", implicit ? "ARKODE_ESDIRK547L2SA_7_4_5" : "ARKODE_DORMAND_PRINCE_7_4_5");
+    rtol_ = s.get("rtol", 1e-6);
+    atol_ = s.get("atol", 1e-9);
+    fixed_ = s.get("fixed_step", false);
+    max_step_ = s.get("max_step", 0.0);
+    init_step_ = s.get("init_step", 0.0);
+    max_steps_ = s.get("max_steps", 1e8);
+    mass_solver_ = s.get("mass_solver", "eigen-ldlt");
+    chart_overshoot_ = s.get("chart_overshoot", 0.05);
+    if (!(chart_overshoot_ >= 0.0 && chart_overshoot_ < 0.3))
+      throw std::invalid_argument(name_ + ": chart_overshoot must be in [0, 0.3), got " + std::to_string(chart_overshoot_));
+    if (implicit) {
+      linear_solver_ = s.get("linear_solver", "eigen-ldlt");
+      max_nonlin_ = s.get("max_nonlin_iters", 3);
+      lsetup_frequency_ = s.get("lsetup_frequency", 0);
+    }
+    check_tolerances(name_, rtol_, atol_);
+    if (!(max_step_ >= 0.0) || !(init_step_ >= 0.0))
+      throw std::invalid_argument(name_ + ": max_step and init_step must be >= 0 (0 = ARKODE's choice)");
+    if (!(max_steps_ >= 1.0)) throw std::invalid_argument(name_ + ": max_steps must be >= 1");
+    if (fixed_ && !(dt_ > 0.0 && std::isfinite(dt_)))
+      throw std::invalid_argument(name_ + ": fixed_step needs a positive time step dt, got " + std::to_string(dt_));
+    if (mass_solver_ != "eigen-ldlt" && mass_solver_ != "cholmod")
+      throw std::invalid_argument(name_ + ": mass_solver '" + mass_solver_ +
+                                  "' is not valid (the mass matrix is SPD: use eigen-ldlt or cholmod)");
+    if (implicit) {
+      const auto names = linear_solver_names();
+      if (std::find(names.begin(), names.end(), linear_solver_) == names.end())
+        throw std::invalid_argument(name_ + ": unknown linear_solver '" + linear_solver_ +
+                                    "' (M + gamma^2 K is symmetric: eigen-ldlt, cholmod or klu)");
+      if (lsetup_frequency_ < 0) throw std::invalid_argument(name_ + ": lsetup_frequency must be >= 0 (0 = ARKODE default 20)");
+      if (max_nonlin_ < 1) throw std::invalid_argument(name_ + ": max_nonlin_iters must be >= 1");
+    }
+    // Validate the table now, so that a typo is a settings error, not a failure at initialize().
+    ARKodeButcherTable B = implicit ? ARKodeButcherTable_LoadDIRKByName(table_.c_str())
+                                    : ARKodeButcherTable_LoadERKByName(table_.c_str());
+    if (B == nullptr)
+      throw std::invalid_argument(name_ + ": unknown " + (implicit ? "DIRK" : "ERK") + " table '" + table_ +
+                                  "' (SUNDIALS 6.4.1 names, e.g. " +
+                                  (implicit ? "ARKODE_ESDIRK547L2SA_7_4_5, ARKODE_SDIRK_5_3_4"
+                                            : "ARKODE_DORMAND_PRINCE_7_4_5, ARKODE_VERNER_8_5_6") +
+                                  "; see spec/stack.md §4.4)");
+    const bool embedded = B->d != nullptr;
+    ARKodeButcherTable_Free(B);
+    if (!embedded && !fixed_)
+      throw std::invalid_argument(name_ + ": table '" + table_ +
+                                  "' has no embedding and cannot adapt the step: set fixed_step: true");
+    resolved_ = s.resolved();
+  }
+
+  ~ArkodeIntegrator() override { free_ark(); }
+
+  std::string name() const override { return name_; }
+  std::vector<std::pair<std::string, std::string>> settings() const override { return resolved_; }
+  double external_work() const override { return w_; }
+
+  void initialize(SemiDiscreteSystem& system, State& state) override {
+    free_ark();
+    sys_ = &system;
+    ctx_ = std::make_unique<SunContext>();
+    fos_ = std::make_unique<FirstOrderSystem>(system, mass_solver_);
+    n_ = system.num_dofs();
+    const Index N = 2 * n_ + 1;
+    if (system.chart_margin(state) < 0.0) system.rechart(state);
+    fos_->acceleration(state.t, state, state.a);
+    w_ = 0.0;
+    t_ = state.t;
+    work_ = state;
+    y_ = make_serial_vector(N, *ctx_);
+    atol_v_ = make_serial_vector(N, *ctx_);
+    fos_->pack(state, w_, data(y_.get()));
+    fos_->absolute_tolerances(state, atol_, data(atol_v_.get()));
+
+    mem_ = implicit_ ? ARKStepCreate(nullptr, rhs, t_, y_.get(), *ctx_) : ARKStepCreate(rhs, nullptr, t_, y_.get(), *ctx_);
+    check_ptr(mem_, "ARKStepCreate");
+    check(ARKStepSetErrHandlerFn(mem_, record_sundials_error, &sundials_message_), "ARKStepSetErrHandlerFn");
+    check(ARKStepSetUserData(mem_, this), "ARKStepSetUserData");
+    check(implicit_ ? ARKStepSetTableName(mem_, table_.c_str(), "ARKODE_ERK_NONE")
+                    : ARKStepSetTableName(mem_, "ARKODE_DIRK_NONE", table_.c_str()),
+          "ARKStepSetTableName");
+    check(ARKStepSVtolerances(mem_, rtol_, atol_v_.get()), "ARKStepSVtolerances");
+    if (fixed_) check(ARKStepSetFixedStep(mem_, dt_), "ARKStepSetFixedStep");
+    if (max_step_ > 0) check(ARKStepSetMaxStep(mem_, max_step_), "ARKStepSetMaxStep");
+    if (init_step_ > 0) check(ARKStepSetInitStep(mem_, init_step_), "ARKStepSetInitStep");
+    check(ARKStepSetMaxNumSteps(mem_, static_cast<long>(max_steps_)), "ARKStepSetMaxNumSteps");
+    check(ARKStepSetPostprocessStepFn(mem_, after_step), "ARKStepSetPostprocessStepFn");
+    check(ARKStepRootInit(mem_, 1, root), "ARKStepRootInit");
+    int direction = -1;  // only a margin going negative is an event
+    check(ARKStepSetRootDirection(mem_, &direction), "ARKStepSetRootDirection");
+    check(ARKStepSetNoInactiveRootWarn(mem_), "ARKStepSetNoInactiveRootWarn");
+    if (implicit_) setup_newton_solver(system);
+    base_ = ArkCounters{};
+  }
+
+  StepReport advance(SemiDiscreteSystem& system, State& state, double t_out) override {
+    if (mem_ == nullptr) throw std::logic_error(name_ + ": advance() before initialize()");
+    const auto wall0 = std::chrono::steady_clock::now();
+    sys_ = &system;
+    StepReport rep;
+    const long fact0 = factorizations();
+    if (!in_sync(state)) restart_from(state, rep);
+    if (t_out < t_) {
+      std::ostringstream os;
+      os << name_ << ": t_out = " << t_out << " is before the current time " << t_;
+      throw std::invalid_argument(os.str());
+    }
+    const double t_tol = 1e-12 * std::max(1.0, std::abs(t_out));
+    while (t_out - t_ > t_tol) {
+      check(ARKStepSetStopTime(mem_, t_out), "ARKStepSetStopTime");
+      errors_.clear();
+      sundials_message_.clear();
+      double tret = t_;
+      const int flag = ARKStepEvolve(mem_, t_out, y_.get(), &tret, ARK_NORMAL);
+      if (flag < 0) {
+        add_counters(rep);
+        fail(flag, tret);
+      }
+      t_ = tret;
+      if (!all_finite(data(y_.get()), 2 * n_ + 1)) {
+        add_counters(rep);
+        fail(ARK_SUCCESS, tret, "non-finite solution");
+      }
+      if (flag == ARK_ROOT_RETURN) {
+        ++rep.root_events;
+        read_y(work_);
+        fos_->acceleration(t_, work_, work_.a);
+        const int switched = system.rechart(work_);
+        rep.chart_switches += switched;
+        if (switched > 0) {
+          add_counters(rep);
+          fos_->pack(work_, w_, data(y_.get()));
+          check(ARKStepReInit(mem_, implicit_ ? nullptr : rhs, implicit_ ? rhs : nullptr, t_, y_.get()),
+                "ARKStepReInit");
+          base_ = ArkCounters{};
+          ++rep.reinitializations;
+        }
+      }
+    }
+    add_counters(rep);
+    read_y(work_);
+    work_.t = t_out;
+    t_ = t_out;
+    fos_->acceleration(t_, work_, work_.a);  // state.a = v̇(t_out)
+    state = work_;
+    double h = 0;
+    ARKStepGetLastStep(mem_, &h);
+    rep.last_dt = h;
+    rep.factorizations = factorizations() - fact0;
+    rep.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+    return rep;
+  }
+
+ private:
+  void read_y(State& s) {
+    const double* y = data(y_.get());
+    fos_->unpack(y, s);
+    s.t = t_;
+    w_ = y[2 * n_];
+  }
+
+  bool in_sync(const State& s) const {
+    if (s.t != t_ || s.u.size() != n_ || s.charts.size() != work_.charts.size()) return false;
+    for (size_t i = 0; i < s.charts.size(); ++i)
+      if (s.charts[i].l != work_.charts[i].l || s.charts[i].n != work_.charts[i].n || s.charts[i].s != work_.charts[i].s)
+        return false;
+    return s.u == Eigen::Map<const Eigen::VectorXd>(data(y_.get()), n_) &&
+           s.v == Eigen::Map<const Eigen::VectorXd>(data(y_.get()) + n_, n_);
+  }
+  void restart_from(State& s, StepReport& rep) {
+    add_counters(rep);
+    t_ = s.t;
+    work_ = s;
+    fos_->pack(s, w_, data(y_.get()));
+    check(ARKStepReInit(mem_, implicit_ ? nullptr : rhs, implicit_ ? rhs : nullptr, t_, y_.get()), "ARKStepReInit");
+    base_ = ArkCounters{};
+    ++rep.reinitializations;
+  }
+
+  long factorizations() const {
+    long f = fos_->mass_factorizations();
+    if (newton_solver_) f += newton_solver_->stats().factorizations;
+    return f;
+  }
+
+  ArkCounters counters() const {
+    ArkCounters c;
+    ARKStepGetNumSteps(mem_, &c.steps);
+    ARKStepGetNumStepAttempts(mem_, &c.attempts);
+    ARKStepGetNumRhsEvals(mem_, &c.fe, &c.fi);
+    if (implicit_) {
+      ARKStepGetNumNonlinSolvIters(mem_, &c.newton);
+      ARKStepGetNumLinSolvSetups(mem_, &c.setups);
+    }
+    return c;
+  }
+  void add_counters(StepReport& rep) {
+    const ArkCounters c = counters();
+    rep.steps += c.steps - base_.steps;
+    rep.rejected_steps += (c.attempts - base_.attempts) - (c.steps - base_.steps);
+    rep.rhs_evaluations += (c.fe - base_.fe) + (c.fi - base_.fi);
+    rep.nonlinear_iterations += c.newton - base_.newton;
+    rep.linear_setups += c.setups - base_.setups;
+    base_ = c;
+  }
+
+  [[noreturn]] void fail(int flag, double t, const std::string& what = "") {
+    double h = 0;
+    ARKStepGetCurrentStep(mem_, &h);
+    std::ostringstream os;
+    os << name_ << ": ARKStepEvolve failed at t = " << t << " (step size " << h << ")";
+    if (flag < 0) os << " with " << flag_name(ARKStepGetReturnFlagName, flag);
+    if (!what.empty()) os << ": " << what;
+    if (errors_.has_error()) os << "; " << errors_.message();
+    if (!sundials_message_.empty()) os << "; " << sundials_message_;
+    throw StepFailure(os.str());
+  }
+
+  void check(int flag, const char* call) const { check_flag(flag, call, ARKStepGetReturnFlagName); }
+
+  void free_ark() {
+    if (mem_) ARKStepFree(&mem_);
+    mem_ = nullptr;
+  }
+
+  // --- the Newton solver of arkode-dirk (header): custom matrix + custom solver + linsys function ---
+  void setup_newton_solver(SemiDiscreteSystem& system) {
+    K_.pattern = M_.pattern = S_.pattern = system.pattern();
+    K_.values.assign(static_cast<size_t>(system.pattern()->nnz()), 0.0);
+    M_.values = S_.values = K_.values;
+    newton_solver_ = make_linear_solver(linear_solver_);
+    bq_.resize(n_);
+    rhs_.resize(n_);
+    tmp_.resize(n_);
+    xq_.resize(n_);
+
+    A_.reset(SUNMatNewEmpty(*ctx_));
+    check_ptr(A_.get(), "SUNMatNewEmpty");
+    A_->content = this;
+    A_->ops->getid = [](SUNMatrix) { return SUNMATRIX_CUSTOM; };
+    A_->ops->destroy = [](SUNMatrix A) { SUNMatFreeEmpty(A); };
+    A_->ops->clone = [](SUNMatrix A) -> SUNMatrix {
+      SUNMatrix B = SUNMatNewEmpty(A->sunctx);
+      if (B == nullptr) return nullptr;
+      if (SUNMatCopyOps(A, B) != 0) {
+        SUNMatFreeEmpty(B);
+        return nullptr;
+      }
+      B->content = A->content;
+      return B;
+    };
+
+    LS_.reset(SUNLinSolNewEmpty(*ctx_));
+    check_ptr(LS_.get(), "SUNLinSolNewEmpty");
+    LS_->content = this;
+    LS_->ops->gettype = [](SUNLinearSolver) { return SUNLINEARSOLVER_DIRECT; };
+    LS_->ops->getid = [](SUNLinearSolver) { return SUNLINEARSOLVER_CUSTOM; };
+    LS_->ops->initialize = [](SUNLinearSolver) { return static_cast<int>(SUNLS_SUCCESS); };
+    LS_->ops->setup = ls_setup;
+    LS_->ops->solve = ls_solve;
+    LS_->ops->lastflag = [](SUNLinearSolver S) {
+      return static_cast<sunindextype>(static_cast<ArkodeIntegrator*>(S->content)->ls_flag_);
+    };
+    LS_->ops->free = [](SUNLinearSolver S) {
+      S->content = nullptr;
+      SUNLinSolFreeEmpty(S);
+      return static_cast<int>(SUNLS_SUCCESS);
+    };
+    check(ARKStepSetLinearSolver(mem_, LS_.get(), A_.get()), "ARKStepSetLinearSolver");
+    check(ARKStepSetLinSysFn(mem_, linsys), "ARKStepSetLinSysFn");
+    check(ARKStepSetMaxNonlinIters(mem_, max_nonlin_), "ARKStepSetMaxNonlinIters");
+    if (lsetup_frequency_ > 0) check(ARKStepSetLSetupFrequency(mem_, lsetup_frequency_), "ARKStepSetLSetupFrequency");
+  }
+
+  // A = I − γJ: re-assemble K and M only when ARKODE asks for a new Jacobian (jok = false).
+  static int linsys(sunrealtype t, N_Vector y, N_Vector, SUNMatrix, SUNMatrix, sunbooleantype jok,
+                    sunbooleantype* jcur, sunrealtype gamma, void* ud, N_Vector, N_Vector, N_Vector) {
+    auto* self = static_cast<ArkodeIntegrator*>(ud);
+    try {
+      if (!jok) {
+        State& s = self->work_;
+        self->fos_->unpack(N_VGetArrayPointer(y), s);
+        self->sys_->internal(s.u, s.charts, nullptr, &self->K_);
+        self->sys_->add_load_stiffness(t, s.u, s.charts, self->K_);
+        self->sys_->mass(s.u, s.charts, self->M_);
+        *jcur = SUNTRUE;
+      } else {
+        *jcur = SUNFALSE;
+      }
+      self->gamma_ = gamma;
+      return 0;
+    } catch (const std::domain_error&) {
+      return 1;
+    } catch (...) {
+      self->errors_.capture("arkode-dirk linear system");
+      return -1;
+    }
+  }
+
+  // Factorize S = M + γ²K with constrained rows/columns as identity (Schur complement, header).
+  static int ls_setup(SUNLinearSolver S, SUNMatrix) {
+    auto* self = static_cast<ArkodeIntegrator*>(S->content);
+    try {
+      const double g2 = self->gamma_ * self->gamma_;
+      for (size_t k = 0; k < self->S_.values.size(); ++k)
+        self->S_.values[k] = self->M_.values[k] + g2 * self->K_.values[k];
+      apply_dirichlet(self->sys_->dofs(), self->S_, nullptr, 1.0);
+      self->newton_solver_->factorize(self->S_.view());
+      self->gamma_factored_ = self->gamma_;
+      return self->ls_flag_ = SUNLS_SUCCESS;
+    } catch (...) {
+      self->errors_.capture("arkode-dirk Newton-matrix factorization");
+      return self->ls_flag_ = SUNLS_PACKAGE_FAIL_REC;
+    }
+  }
+
+  static int ls_solve(SUNLinearSolver S, SUNMatrix, N_Vector x, N_Vector b, sunrealtype) {
+    auto* self = static_cast<ArkodeIntegrator*>(S->content);
+    try {
+      const Index n = self->n_;
+      const double g = self->gamma_factored_;
+      const double* bp = N_VGetArrayPointer(b);
+      double* xp = N_VGetArrayPointer(x);
+      const DofMap& dofs = self->sys_->dofs();
+      Eigen::Map<const Eigen::VectorXd> b_q(bp, n), b_v(bp + n, n);
+      // Free rows: (M_ff + γ²K_ff) x_q,f = M_ff (b_q + γ b_v)_f − γ² K_fc x_q,c.
+      self->bq_ = b_q + g * b_v;
+      self->xq_.setZero();
+      for (Index c : dofs.constrained_dofs()) {
+        self->xq_[c] = self->bq_[c];
+        self->bq_[c] = 0.0;
+      }
+      multiply(self->M_.view(), self->bq_.data(), self->rhs_.data());
+      if (dofs.num_constrained() > 0) {
+        multiply(self->K_.view(), self->xq_.data(), self->tmp_.data());
+        self->rhs_ -= g * g * self->tmp_;
+      }
+      for (Index c : dofs.constrained_dofs()) self->rhs_[c] = self->xq_[c];
+      self->newton_solver_->solve(self->rhs_.data(), xp);
+      for (Index i = 0; i < n; ++i) xp[n + i] = (xp[i] - bp[i]) / g;
+      for (Index c : dofs.constrained_dofs()) xp[n + c] = bp[n + c];
+      xp[2 * n] = bp[2 * n];
+      if (!all_finite(xp, 2 * n + 1)) return self->ls_flag_ = SUNLS_PACKAGE_FAIL_REC;
+      return self->ls_flag_ = SUNLS_SUCCESS;
+    } catch (...) {
+      self->errors_.capture("arkode-dirk Newton solve");
+      return self->ls_flag_ = SUNLS_PACKAGE_FAIL_UNREC;
+    }
+  }
+
+  // --- RHS, root and post-step callbacks: no exception crosses them ---
+  static int rhs(sunrealtype t, N_Vector y, N_Vector ydot, void* ud) {
+    auto* self = static_cast<ArkodeIntegrator*>(ud);
+    try {
+      const Index n = self->n_;
+      const double* yv = N_VGetArrayPointer(y);
+      double* f = N_VGetArrayPointer(ydot);
+      State& s = self->work_;
+      self->fos_->unpack(yv, s);
+      const double power = self->fos_->acceleration(t, s, self->a_);
+      std::copy(yv + n, yv + 2 * n, f);
+      std::copy(self->a_.data(), self->a_.data() + n, f + n);
+      f[2 * n] = power;
+      return 0;
+    } catch (const std::domain_error& e) {
+      // Non-finite stage or director overshoot (spec/element.md §2.1 guard): adaptive steppers retry
+      // with a smaller step; a fixed step cannot, so stop with the reason.
+      if (!self->fixed_) return 1;
+      self->errors_.capture("right-hand side");
+      return -1;
+    } catch (...) {
+      self->errors_.capture("right-hand side");
+      return -1;
+    }
+  }
+
+  static int root(sunrealtype, N_Vector y, sunrealtype* g, void* ud) {
+    auto* self = static_cast<ArkodeIntegrator*>(ud);
+    try {
+      self->fos_->unpack(N_VGetArrayPointer(y), self->work_);
+      g[0] = self->sys_->chart_margin(self->work_) + self->chart_overshoot_;
+      return 0;
+    } catch (...) {
+      self->errors_.capture("chart-margin root function");
+      return -1;
+    }
+  }
+
+  // Every accepted step: a non-finite state means the step was unstable (stack.md §7 item 11).
+  static int after_step(sunrealtype t, N_Vector y, void* ud) {
+    auto* self = static_cast<ArkodeIntegrator*>(ud);
+    if (all_finite(N_VGetArrayPointer(y), 2 * self->n_ + 1)) return 0;
+    try {
+      std::ostringstream os;
+      os << "non-finite state after the step to t = " << t;
+      if (self->fixed_)
+        os << " (fixed step dt = " << self->dt_ << (self->implicit_ ? "" : " is past the explicit stability limit")
+           << "; use a smaller dt or adaptive stepping)";
+      throw std::runtime_error(os.str());
+    } catch (...) {
+      self->errors_.capture(self->name_.c_str());
+    }
+    return -1;
+  }
+
+  // settings
+  bool implicit_;
+  double dt_;
+  std::string name_, table_, mass_solver_, linear_solver_;
+  double rtol_ = 0, atol_ = 0, max_step_ = 0, init_step_ = 0, max_steps_ = 0, chart_overshoot_ = 0.05;
+  bool fixed_ = false;
+  int max_nonlin_ = 3, lsetup_frequency_ = 0;
+  std::vector<std::pair<std::string, std::string>> resolved_;
+
+  // run objects (ctx_ first: freed last)
+  std::unique_ptr<SunContext> ctx_;
+  NVectorPtr y_, atol_v_;
+  SunMatrixPtr A_;
+  SunLinearSolverPtr LS_;
+  void* mem_ = nullptr;
+
+  SemiDiscreteSystem* sys_ = nullptr;
+  std::unique_ptr<FirstOrderSystem> fos_;
+  Index n_ = 0;
+  State work_;
+  double t_ = 0.0, w_ = 0.0;
+  Eigen::VectorXd a_;
+
+  // Newton solver of arkode-dirk
+  std::unique_ptr<LinearSolver> newton_solver_;
+  SparseMatrix K_, M_, S_;
+  double gamma_ = 0.0, gamma_factored_ = 0.0;
+  int ls_flag_ = SUNLS_SUCCESS;
+  Eigen::VectorXd bq_, rhs_, tmp_, xq_;
+
+  ArkCounters base_;
+  CallbackError errors_;
+  std::string sundials_message_;
+};
+
+}  // namespace
+
+std::unique_ptr<Integrator> make_arkode_erk(IntegratorSettings& settings, double dt) {
+  return std::make_unique<ArkodeIntegrator>(settings, dt, false);
+}
+
+std::unique_ptr<Integrator> make_arkode_dirk(IntegratorSettings& settings, double dt) {
+  return std::make_unique<ArkodeIntegrator>(settings, dt, true);
+}
+
+}  // namespace shelldyn

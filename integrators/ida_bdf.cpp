@@ -1,0 +1,417 @@
+#include "integrators/ida_bdf.hpp"
+
+#include "integrators/first_order_system.hpp"
+#include "integrators/sun_linear_solver.hpp"
+#include "integrators/sundials_support.hpp"
+#include "lib/assembler.hpp"
+
+#include <ida/ida.h>
+#include <ida/ida_ls.h>
+
+#include <chrono>
+#include <cmath>
+#include <sstream>
+
+namespace shelldyn {
+namespace {
+
+// Cumulative IDA counters since the last IDAInit/IDAReInit (IDAReInit resets them).
+struct IdaCounters {
+  long steps = 0, residuals = 0, newton = 0, conv_fails = 0, err_fails = 0, setups = 0;
+};
+
+class IdaBdf final : public Integrator {
+ public:
+  IdaBdf(IntegratorSettings& s, double /*dt: IDA chooses its own steps (init_step)*/) {
+    rtol_ = s.get("rtol", 1e-6);
+    atol_ = s.get("atol", 1e-9);
+    max_order_ = s.get("max_order", 5);
+    max_step_ = s.get("max_step", 0.0);
+    init_step_ = s.get("init_step", 0.0);
+    linear_solver_ = s.get("linear_solver", "klu");
+    jacobian_ = s.get("jacobian", "approximate");
+    mass_solver_ = s.get("mass_solver", "eigen-ldlt");
+    max_steps_ = s.get("max_steps", 1e8);
+    chart_overshoot_ = s.get("chart_overshoot", 0.05);
+    check_tolerances("ida-bdf", rtol_, atol_);
+    if (!(chart_overshoot_ >= 0.0 && chart_overshoot_ < 0.3))
+      throw std::invalid_argument("ida-bdf: chart_overshoot must be in [0, 0.3), got " + std::to_string(chart_overshoot_));
+    if (max_order_ < 1 || max_order_ > 5)
+      throw std::invalid_argument("ida-bdf: max_order must be 1..5, got " + std::to_string(max_order_));
+    if (!(max_step_ >= 0.0) || !(init_step_ >= 0.0))
+      throw std::invalid_argument("ida-bdf: max_step and init_step must be >= 0 (0 = IDA's choice)");
+    if (linear_solver_ != "klu")
+      throw std::invalid_argument("ida-bdf: linear_solver '" + linear_solver_ +
+                                  "' is not supported: the IDA iteration matrix [[c_j I, -I], [K, c_j M]] is "
+                                  "not symmetric, and only klu factors non-symmetric matrices");
+    if (jacobian_ != "approximate" && jacobian_ != "fd-inertia")
+      throw std::invalid_argument("ida-bdf: jacobian must be 'approximate' or 'fd-inertia', got '" + jacobian_ +
+                                  "'");
+    if (mass_solver_ != "eigen-ldlt" && mass_solver_ != "cholmod")
+      throw std::invalid_argument("ida-bdf: mass_solver '" + mass_solver_ +
+                                  "' is not valid (the mass matrix is SPD: use eigen-ldlt or cholmod)");
+    if (!(max_steps_ >= 1.0)) throw std::invalid_argument("ida-bdf: max_steps must be >= 1");
+    resolved_ = s.resolved();
+  }
+
+  ~IdaBdf() override { free_ida(); }
+
+  std::string name() const override { return "ida-bdf"; }
+  std::vector<std::pair<std::string, std::string>> settings() const override { return resolved_; }
+  double external_work() const override { return w_; }
+
+  void initialize(SemiDiscreteSystem& system, State& state) override {
+    free_ida();
+    sys_ = &system;
+    ctx_ = std::make_unique<SunContext>();
+    fos_ = std::make_unique<FirstOrderSystem>(system, mass_solver_);
+    n_ = system.num_dofs();
+    const Index N = 2 * n_ + 1;
+    build_block_pattern(*system.pattern());
+    K_.pattern = M_.pattern = G_v_.pattern = system.pattern();
+    K_.values.assign(static_cast<size_t>(system.pattern()->nnz()), 0.0);
+    M_.values = G_v_.values = K_.values;
+    fext_.resize(n_);
+
+    // A director past its chart's margin at the start: switch first (spec/element.md §2.3).
+    if (system.chart_margin(state) < 0.0) system.rechart(state);
+    fos_->acceleration(state.t, state, state.a);
+    w_ = 0.0;
+    t_ = state.t;
+    work_ = state;
+
+    y_ = make_serial_vector(N, *ctx_);
+    yp_ = make_serial_vector(N, *ctx_);
+    id_ = make_serial_vector(N, *ctx_);
+    atol_v_ = make_serial_vector(N, *ctx_);
+    write_y(state);
+    fos_->absolute_tolerances(state, atol_, data(atol_v_.get()));
+    N_VConst(1.0, id_.get());
+    J_ = make_csc_matrix(*big_.pattern, *ctx_);
+    LS_.reset(make_sun_linear_solver(*ctx_, make_linear_solver(linear_solver_)));
+
+    mem_ = IDACreate(*ctx_);
+    check_ptr(mem_, "IDACreate");
+    check(IDASetErrHandlerFn(mem_, record_sundials_error, &sundials_message_), "IDASetErrHandlerFn");
+    check(IDAInit(mem_, residual, t_, y_.get(), yp_.get()), "IDAInit");
+    check(IDASVtolerances(mem_, rtol_, atol_v_.get()), "IDASVtolerances");
+    check(IDASetUserData(mem_, this), "IDASetUserData");
+    check(IDASetLinearSolver(mem_, LS_.get(), J_.get()), "IDASetLinearSolver");
+    check(IDASetJacFn(mem_, jacobian), "IDASetJacFn");
+    check(IDASetId(mem_, id_.get()), "IDASetId");
+    check(IDASetMaxOrd(mem_, max_order_), "IDASetMaxOrd");
+    if (max_step_ > 0) check(IDASetMaxStep(mem_, max_step_), "IDASetMaxStep");
+    if (init_step_ > 0) check(IDASetInitStep(mem_, init_step_), "IDASetInitStep");
+    check(IDASetMaxNumSteps(mem_, static_cast<long>(max_steps_)), "IDASetMaxNumSteps");
+    check(IDARootInit(mem_, 1, root), "IDARootInit");
+    int direction = -1;  // only a margin going negative is an event
+    check(IDASetRootDirection(mem_, &direction), "IDASetRootDirection");
+    check(IDASetNoInactiveRootWarn(mem_), "IDASetNoInactiveRootWarn");
+    base_ = IdaCounters{};
+  }
+
+  StepReport advance(SemiDiscreteSystem& system, State& state, double t_out) override {
+    if (mem_ == nullptr) throw std::logic_error("ida-bdf: advance() before initialize()");
+    const auto wall0 = std::chrono::steady_clock::now();
+    sys_ = &system;
+    StepReport rep;
+    const long fact0 = sun_linear_solver_backend(LS_.get()).stats().factorizations;
+    if (!in_sync(state)) restart_from(state, rep);
+    if (t_out < t_) {
+      std::ostringstream os;
+      os << "ida-bdf: t_out = " << t_out << " is before the current time " << t_;
+      throw std::invalid_argument(os.str());
+    }
+    const double t_tol = 1e-12 * std::max(1.0, std::abs(t_out));
+    while (t_out - t_ > t_tol) {
+      check(IDASetStopTime(mem_, t_out), "IDASetStopTime");
+      errors_.clear();
+      sundials_message_.clear();
+      double tret = t_;
+      const int flag = IDASolve(mem_, t_out, &tret, y_.get(), yp_.get(), IDA_NORMAL);
+      if (flag < 0) {
+        add_counters(rep);
+        fail(flag, tret);
+      }
+      t_ = tret;
+      if (!all_finite(data(y_.get()), 2 * n_ + 1)) {
+        add_counters(rep);
+        fail(IDA_SUCCESS, tret, "non-finite solution");
+      }
+      if (flag == IDA_ROOT_RETURN) {
+        ++rep.root_events;
+        read_y(work_);
+        const int switched = system.rechart(work_);
+        rep.chart_switches += switched;
+        if (switched > 0) {
+          add_counters(rep);
+          write_y(work_, data(yp_.get())[2 * n_]);
+          check(IDAReInit(mem_, t_, y_.get(), yp_.get()), "IDAReInit");
+          base_ = IdaCounters{};
+          ++rep.reinitializations;
+        }
+      }
+    }
+    add_counters(rep);
+    read_y(work_);
+    work_.t = t_out;
+    t_ = t_out;
+    state = work_;
+    double h = 0;
+    IDAGetLastStep(mem_, &h);
+    rep.last_dt = h;
+    rep.factorizations = sun_linear_solver_backend(LS_.get()).stats().factorizations - fact0;
+    rep.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+    return rep;
+  }
+
+ private:
+  // --- state <-> (y, ẏ) ---
+  void write_y(const State& s, double wdot = 0.0) {
+    double* y = data(y_.get());
+    double* yp = data(yp_.get());
+    fos_->pack(s, w_, y);
+    std::copy(s.v.data(), s.v.data() + n_, yp);
+    std::copy(s.a.data(), s.a.data() + n_, yp + n_);
+    yp[2 * n_] = wdot;
+  }
+  void read_y(State& s) {
+    const double* y = data(y_.get());
+    fos_->unpack(y, s);
+    s.a = Eigen::Map<const Eigen::VectorXd>(data(yp_.get()) + n_, n_);
+    s.t = t_;
+    w_ = y[2 * n_];
+  }
+
+  // The caller may have re-charted or replaced the state between calls (a driver that re-charts
+  // fixed-step schemes between steps): re-initialize from it in that case.
+  bool in_sync(const State& s) const {
+    if (s.t != t_ || s.u.size() != n_ || s.charts.size() != work_.charts.size()) return false;
+    for (size_t i = 0; i < s.charts.size(); ++i)
+      if (s.charts[i].l != work_.charts[i].l || s.charts[i].n != work_.charts[i].n || s.charts[i].s != work_.charts[i].s)
+        return false;
+    return s.u == Eigen::Map<const Eigen::VectorXd>(data(y_.get()), n_) &&
+           s.v == Eigen::Map<const Eigen::VectorXd>(data(y_.get()) + n_, n_);
+  }
+  void restart_from(State& s, StepReport& rep) {
+    add_counters(rep);
+    t_ = s.t;
+    fos_->acceleration(s.t, s, s.a);
+    work_ = s;
+    write_y(s, data(yp_.get())[2 * n_]);
+    check(IDAReInit(mem_, t_, y_.get(), yp_.get()), "IDAReInit");
+    base_ = IdaCounters{};
+    ++rep.reinitializations;
+  }
+
+  // --- statistics ---
+  IdaCounters counters() const {
+    IdaCounters c;
+    IDAGetNumSteps(mem_, &c.steps);
+    IDAGetNumResEvals(mem_, &c.residuals);
+    IDAGetNumNonlinSolvIters(mem_, &c.newton);
+    IDAGetNumNonlinSolvConvFails(mem_, &c.conv_fails);
+    IDAGetNumErrTestFails(mem_, &c.err_fails);
+    IDAGetNumLinSolvSetups(mem_, &c.setups);
+    return c;
+  }
+  void add_counters(StepReport& rep) {
+    const IdaCounters c = counters();
+    rep.steps += c.steps - base_.steps;
+    rep.rhs_evaluations += c.residuals - base_.residuals;
+    rep.nonlinear_iterations += c.newton - base_.newton;
+    rep.rejected_steps += (c.conv_fails - base_.conv_fails) + (c.err_fails - base_.err_fails);
+    rep.linear_setups += c.setups - base_.setups;
+    base_ = c;
+  }
+
+  [[noreturn]] void fail(int flag, double t, const std::string& what = "") {
+    double h = 0;
+    IDAGetCurrentStep(mem_, &h);
+    std::ostringstream os;
+    os << "ida-bdf: IDASolve failed at t = " << t << " (step size " << h << ")";
+    if (flag < 0) os << " with " << flag_name(IDAGetReturnFlagName, flag);
+    if (!what.empty()) os << ": " << what;
+    if (!sundials_message_.empty()) os << "; " << sundials_message_;
+    if (errors_.has_error()) os << "; " << errors_.message();
+    const std::string& ls = sun_linear_solver_last_error(LS_.get());
+    if (!ls.empty()) os << "; " << ls;
+    throw StepFailure(os.str());
+  }
+
+  void check(int flag, const char* call) const { check_flag(flag, call, IDAGetReturnFlagName); }
+
+  void free_ida() {
+    if (mem_) IDAFree(&mem_);
+    mem_ = nullptr;
+  }
+
+  // --- Jacobian pattern: columns [q (n) | v (n) | w (1)], rows likewise ---
+  void build_block_pattern(const SparsePattern& P) {
+    auto big = std::make_shared<SparsePattern>();
+    const Index n = P.n, N = 2 * n + 1;
+    big->n = N;
+    big->colptr.reserve(static_cast<size_t>(N) + 1);
+    big->colptr.push_back(0);
+    auto& rows = big->rowind;
+    for (Index j = 0; j < n; ++j) {  // q columns: (j, j) then the K rows
+      rows.push_back(j);
+      for (Index k = P.colptr[j]; k < P.colptr[j + 1]; ++k) rows.push_back(n + P.rowind[k]);
+      big->colptr.push_back(static_cast<Index>(rows.size()));
+    }
+    for (Index j = 0; j < n; ++j) {  // v columns: (j, n+j) = −1, the M rows, then the w row
+      rows.push_back(j);
+      for (Index k = P.colptr[j]; k < P.colptr[j + 1]; ++k) rows.push_back(n + P.rowind[k]);
+      rows.push_back(2 * n);
+      big->colptr.push_back(static_cast<Index>(rows.size()));
+    }
+    rows.push_back(2 * n);
+    big->colptr.push_back(static_cast<Index>(rows.size()));
+    big_.pattern = big;
+    big_.values.assign(rows.size(), 0.0);
+  }
+
+  // Forward differences of h(q, v) = M(q) v̇ + F_m(q, v): G_q += ∂h/∂q into K_, G_v = ∂F_m/∂v.
+  void add_fd_inertia(const State& s, const Eigen::VectorXd& a) {
+    const SparsePattern& P = *K_.pattern;
+    SparseMatrix Mp{K_.pattern, std::vector<double>(K_.values.size())};
+    Eigen::VectorXd h0(n_), hp(n_), fm(n_);
+    auto h = [&](const Eigen::VectorXd& u, const Eigen::VectorXd& v, Eigen::VectorXd& out) {
+      sys_->mass(u, s.charts, Mp);
+      multiply(Mp.view(), a.data(), out.data());
+      sys_->inertial(u, v, s.charts, fm.data());
+      out += fm;
+    };
+    h(s.u, s.v, h0);
+    Eigen::VectorXd u = s.u, v = s.v;
+    for (Index j = 0; j < n_; ++j) {
+      const double eq = 1e-7 * std::max(1.0, std::abs(u[j]));
+      u[j] += eq;
+      h(u, s.v, hp);
+      u[j] = s.u[j];
+      for (Index k = P.colptr[j]; k < P.colptr[j + 1]; ++k) K_.values[k] += (hp[P.rowind[k]] - h0[P.rowind[k]]) / eq;
+      const double ev = 1e-7 * std::max(1.0, std::abs(v[j]));
+      v[j] += ev;
+      h(s.u, v, hp);
+      v[j] = s.v[j];
+      for (Index k = P.colptr[j]; k < P.colptr[j + 1]; ++k) G_v_.values[k] = (hp[P.rowind[k]] - h0[P.rowind[k]]) / ev;
+    }
+  }
+
+  // --- C callbacks: no exception crosses them ---
+  static int residual(sunrealtype t, N_Vector y, N_Vector yp, N_Vector r, void* ud) {
+    auto* self = static_cast<IdaBdf*>(ud);
+    try {
+      const Index n = self->n_;
+      const double* yv = N_VGetArrayPointer(y);
+      const double* ypv = N_VGetArrayPointer(yp);
+      double* rv = N_VGetArrayPointer(r);
+      State& s = self->work_;
+      self->fos_->unpack(yv, s);
+      self->a_ = Eigen::Map<const Eigen::VectorXd>(ypv + n, n);
+      if (!all_finite(yv, 2 * n + 1) || !all_finite(ypv, 2 * n + 1)) return 1;  // recoverable: cut the step
+      const double power = self->fos_->momentum_residual(t, s, self->a_, self->r_);
+      for (Index i = 0; i < n; ++i) rv[i] = ypv[i] - yv[n + i];
+      std::copy(self->r_.data(), self->r_.data() + n, rv + n);
+      rv[2 * n] = ypv[2 * n] - power;
+      return 0;
+    } catch (const std::domain_error&) {
+      return 1;  // director overshoot (spec/element.md §2.1 guard) or non-finite: IDA cuts the step
+    } catch (...) {
+      self->errors_.capture("ida-bdf residual");
+      return -1;
+    }
+  }
+
+  static int jacobian(sunrealtype t, sunrealtype cj, N_Vector y, N_Vector yp, N_Vector, SUNMatrix J, void* ud,
+                      N_Vector, N_Vector, N_Vector) {
+    auto* self = static_cast<IdaBdf*>(ud);
+    try {
+      const Index n = self->n_;
+      const double* yv = N_VGetArrayPointer(y);
+      State& s = self->work_;
+      self->fos_->unpack(yv, s);
+      self->a_ = Eigen::Map<const Eigen::VectorXd>(N_VGetArrayPointer(yp) + n, n);
+      const SemiDiscreteSystem& sys = *self->sys_;
+      sys.internal(s.u, s.charts, nullptr, &self->K_);
+      sys.add_load_stiffness(t, s.u, s.charts, self->K_);
+      sys.mass(s.u, s.charts, self->M_);
+      sys.external(t, s.u, s.charts, self->fext_.data());
+      self->G_v_.set_zero();
+      if (self->jacobian_ == "fd-inertia") self->add_fd_inertia(s, self->a_);
+
+      const SparsePattern& P = *self->K_.pattern;
+      const DofMap& dofs = sys.dofs();
+      const Index* bcol = self->big_.pattern->colptr.data();
+      double* val = self->big_.values.data();
+      for (Index j = 0; j < n; ++j) {
+        Index pq = bcol[j], pv = bcol[n + j];
+        val[pq++] = cj;
+        val[pv++] = -1.0;
+        for (Index k = P.colptr[j]; k < P.colptr[j + 1]; ++k, ++pq, ++pv) {
+          const Index row = P.rowind[k];
+          if (dofs.is_constrained(row)) {  // momentum row replaced by v̇_c = 0
+            val[pq] = 0.0;
+            val[pv] = row == j ? cj : 0.0;
+          } else {
+            val[pq] = self->K_.values[k];
+            val[pv] = cj * self->M_.values[k] + self->G_v_.values[k];
+          }
+        }
+        val[pv] = -self->fext_[j];  // ∂(ẇ − F_ext·v)/∂v_j
+      }
+      val[bcol[2 * n]] = cj;
+      copy_to_sun_matrix(self->big_, J);  // IDA zeroed J, structure included (stack.md §3.2)
+      return 0;
+    } catch (const std::domain_error&) {
+      return 1;
+    } catch (...) {
+      self->errors_.capture("ida-bdf Jacobian");
+      return -1;
+    }
+  }
+
+  static int root(sunrealtype, N_Vector y, N_Vector, sunrealtype* g, void* ud) {
+    auto* self = static_cast<IdaBdf*>(ud);
+    try {
+      self->fos_->unpack(N_VGetArrayPointer(y), self->work_);
+      g[0] = self->sys_->chart_margin(self->work_) + self->chart_overshoot_;
+      return 0;
+    } catch (...) {
+      self->errors_.capture("ida-bdf chart-margin root function");
+      return -1;
+    }
+  }
+
+  // settings
+  double rtol_, atol_, max_step_, init_step_, max_steps_, chart_overshoot_;
+  int max_order_;
+  std::string linear_solver_, jacobian_, mass_solver_;
+  std::vector<std::pair<std::string, std::string>> resolved_;
+
+  // run objects (ctx_ first: freed last)
+  std::unique_ptr<SunContext> ctx_;
+  NVectorPtr y_, yp_, id_, atol_v_;
+  SunMatrixPtr J_;
+  SunLinearSolverPtr LS_;
+  void* mem_ = nullptr;
+
+  SemiDiscreteSystem* sys_ = nullptr;
+  std::unique_ptr<FirstOrderSystem> fos_;
+  Index n_ = 0;
+  State work_;  // current charts; u, v, a are scratch inside callbacks
+  double t_ = 0.0, w_ = 0.0;
+  Eigen::VectorXd a_, r_, fext_;
+  SparseMatrix K_, M_, G_v_, big_;
+  IdaCounters base_;
+  CallbackError errors_;
+  std::string sundials_message_;
+};
+
+}  // namespace
+
+std::unique_ptr<Integrator> make_ida_bdf(IntegratorSettings& settings, double dt) {
+  return std::make_unique<IdaBdf>(settings, dt);
+}
+
+}  // namespace shelldyn

@@ -1,0 +1,48 @@
+// `ida-bdf`: SUNDIALS IDA (variable-order, variable-step BDF) on the residual form of the shell
+// semi-discretization (integrators/first_order_system.hpp), y = [q; v; w]:
+//
+//     F(t, y, ẏ) = [ q̇ − v ;  M(q) v̇ + F_m(q, v) + F_int(q) − F_ext(t, q) ;  ẇ − F_ext·v ]
+//
+// M(q) is handled exactly (ARKStep cannot: stack.md §4.5). Constrained DOFs c keep q̇_c − v_c = 0 and
+// replace their momentum row by v̇_c = 0, so every component is differential (IDASetId all ones).
+//
+// Newton matrix ∂F/∂y + c_j ∂F/∂ẏ on a block CSC pattern built once from pattern() (2n + 1 unknowns):
+//
+//     [ c_j I                      −I                 0   ]
+//     [ K − K_load  (+ G_q)        c_j M  (+ G_v)      0   ]      constrained momentum rows: c_j e_cᵀ
+//     [ 0                          −F_extᵀ            c_j ]
+//
+// with K the exact tangent of F_int and K_load the symmetric load stiffness (add_load_stiffness).
+// What is NOT in the default ("approximate") Jacobian: G_q = ∂(M(q) v̇ + F_m(q, v))/∂q and
+// G_v = ∂F_m/∂v (the Model provides no derivatives of its inertia terms), and ∂(F_ext·v)/∂q.
+// These terms scale like |ω|·c_j M and ω²M against c_j M and K, so omitting them slows Newton (more
+// iterations) but does not change the solution. `jacobian: fd-inertia` adds G_q and G_v by forward
+// differences of the Model's mass()/inertial() (2n evaluations per Jacobian: for measurements only;
+// see tests/integrators/test_ida_bdf.cpp and benchmarks/bench_sundials_baselines.cpp for the cost).
+// Linear solver: the project's custom SUNLinearSolver with KLU (AMD, one analysis per run); the
+// iteration matrix is not symmetric, so the one-triangle back-ends are rejected.
+//
+// Consistent initial ẏ: computed directly, v̇₀ = M(q₀)⁻¹(F_ext − F_int − F_m) with a mass-matrix
+// factorization (exact; no IDACalcIC Newton solve). After a chart switch the Model converts (q, v, v̇)
+// exactly, so IDAReInit gets a consistent (y, ẏ) again.
+//
+// Director charts (spec/element.md §2.3): root function g = chart_margin(state(y)), direction −1
+// (margin going negative), shifted by chart_overshoot δ: g = margin + δ, so the event fires when a director
+// has turned slightly past the diagonal and every node already past it switches in the same event (nodes
+// with nearly equal directors would otherwise trigger one event and one restart each); at a root the state is written back, system.rechart() switches charts and
+// IDA is re-initialized from the converted (y, ẏ). StepReport counts root events, switches and
+// re-initializations.
+//
+// Settings: rtol [1e-6]; atol [1e-9] (scaled per block, FirstOrderSystem::absolute_tolerances);
+// max_order [5]; max_step [0 = none]; init_step [0 = IDA's choice]; linear_solver [klu];
+// jacobian: approximate|fd-inertia [approximate]; mass_solver: eigen-ldlt|cholmod [eigen-ldlt]
+// (initial acceleration); max_steps [1e8] (internal steps per advance() call); chart_overshoot [0.05].
+#pragma once
+
+#include "integrators/integrator.hpp"
+
+namespace shelldyn {
+
+std::unique_ptr<Integrator> make_ida_bdf(IntegratorSettings& settings, double dt);
+
+}  // namespace shelldyn
