@@ -391,7 +391,16 @@ class ArkodeIntegrator final : public Integrator {
       // Non-finite stage or director overshoot (spec/element.md §2.1 guard): adaptive steppers retry
       // with a smaller step; a fixed step cannot, so stop with the reason.
       if (!self->fixed_) return 1;
-      self->errors_.capture("right-hand side");
+      try {
+        std::ostringstream os;
+        os << e.what() << " -- the fixed step dt = " << self->dt_
+           << (self->implicit_ ? " is too large for the Newton iteration"
+                               : " is probably past the explicit stability limit")
+           << " (use a smaller dt or adaptive stepping)";
+        throw std::runtime_error(os.str());
+      } catch (...) {
+        self->errors_.capture("right-hand side");
+      }
       return -1;
     } catch (...) {
       self->errors_.capture("right-hand side");
