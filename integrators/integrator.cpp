@@ -1,6 +1,8 @@
 #include "integrators/integrator.hpp"
 
+#include "integrators/arkode_integrators.hpp"
 #include "integrators/em_generalized_alpha.hpp"
+#include "integrators/ida_bdf.hpp"
 
 #include <map>
 
@@ -17,6 +19,9 @@ const std::map<std::string, Entry>& registry() {
       {"galpha", {make_galpha, "Chung-Hulbert generalized-alpha: alpha_f-weighted end-point internal forces"}},
       {"midpoint", {make_midpoint, "generalized midpoint: internal force at the midpoint configuration (no strain averaging)"}},
       {"newmark", {make_newmark, "Newmark (beta, gamma): forces at t_{n+1}"}},
+      {"ida-bdf", {make_ida_bdf, "SUNDIALS IDA variable-order BDF on the residual form with M(q) (adaptive)"}},
+      {"arkode-erk", {make_arkode_erk, "SUNDIALS ARKStep explicit RK, M(q) factorized per RHS (adaptive or fixed)"}},
+      {"arkode-dirk", {make_arkode_dirk, "SUNDIALS ARKStep ESDIRK, Schur-complement Newton matrix M + gamma^2 K (adaptive or fixed)"}},
   };
   return r;
 }
