@@ -75,6 +75,7 @@ def main():
             first = f.readline()
         if ":" in first:
             case = first.split(":", 1)[1].strip()
+    color = {r["label"]: f"C{i % 10}" for i, r in enumerate(runs)}  # one colour per run in every panel
     hists = {}
     for r in runs:
         p = os.path.join(a.dir, r["label"], "history.csv")
@@ -83,10 +84,10 @@ def main():
 
     fig, (ax, ax2) = plt.subplots(2, 1, figsize=(7, 6), sharex=True)
     for label, h in hists.items():
-        ax.plot(h["t"], h["total"], label=label, lw=1)
+        ax.plot(h["t"], h["total"], label=label, lw=1, color=color[label])
         pts = mechanical_drift(h)
         if pts:
-            ax2.semilogy([p[0] for p in pts], [p[1] for p in pts], lw=1, label=label)
+            ax2.semilogy([p[0] for p in pts], [p[1] for p in pts], lw=1, label=label, color=color[label])
     ax.set_ylabel("total energy H")
     ax.set_title(f"{case}: energy of each run")
     ax.legend(fontsize=7)
@@ -108,7 +109,7 @@ def main():
             d = [math.sqrt(sum((h[k][i] - h[k][ref]) ** 2 for k in keys)) for i in range(ref, len(t))]
             pts = [(t[ref + i], x) for i, x in enumerate(d) if x > 0]
             if pts:
-                axis.semilogy([p[0] for p in pts], [p[1] for p in pts], lw=1, label=label)
+                axis.semilogy([p[0] for p in pts], [p[1] for p in pts], lw=1, label=label, color=color[label])
     a1.set_ylabel("|L - L_ref|")
     a1.set_title(f"{case}: momentum changes after the loads end")
     a1.legend(fontsize=7)
@@ -128,10 +129,10 @@ def main():
             continue
         wall, e, d = fnum(r["wall_s"]), fnum(r["energy_error"]), fnum(r["displacement_error"])
         if math.isfinite(e) and e > 0:
-            w1.loglog(e, wall, "o")
+            w1.loglog(e, wall, "o", color=color[r["label"]])
             w1.annotate(r["label"], (e, wall), fontsize=7)
         if math.isfinite(d) and d > 0:
-            w2.loglog(d, wall, "s")
+            w2.loglog(d, wall, "s", color=color[r["label"]])
             w2.annotate(r["label"], (d, wall), fontsize=7)
     ref = runs[0]["reference"] if runs else ""
     w1.set_xlabel("max |H - H_ref| / (K_ref + V_ref) after the loads")
