@@ -241,7 +241,7 @@ CorotationalFrame CR9Shell::frame(const Vec45& u, const Charts& charts) const {
   return local_increments(u, charts, nullptr);
 }
 
-double CR9Shell::membrane(const Mat39& t1, const Mat39& t0, double c1, double c0, const Mat39& tbar, Vec45* fL,
+double CR9Shell::membrane(const Mat39& t1, const Mat39& t0, double c1, double c0, double b1, double b0, Vec45* fL,
                           Mat45* kL) const {
   const Eigen::Matrix3d hD1 = mat_.thickness * D1_;
   Eigen::Matrix<double, 27, 1> fm = Eigen::Matrix<double, 27, 1>::Zero();
@@ -255,20 +255,19 @@ double CR9Shell::membrane(const Mat39& t1, const Mat39& t0, double c1, double c0
     Eigen::Vector3d e1, e0 = Eigen::Vector3d::Zero();
     Eigen::Matrix<double, 3, 27> Bm;
     // lazyProduct: these small fixed-size products (3×9·9×9, 27×3·3×27) are 2-3x faster coefficient-wise
-    // than through Eigen's blocked GEMM path, which it picks when rows + cols + depth > 20.
-    const bool same_bar = (&tbar == &t1);
+    // than through Eigen's blocked GEMM path, which it picks when rows + cols + depth > 20. The gradient at
+    // t̄ = b1 t1 + b0 t0 is linear in t̄, so t̄H is combined from t1H and t0H without a third product.
+    const bool need0 = (c0 != 0.0 || b0 != 0.0);
     for (int c = 0; c < 3; ++c) {
       const Mat39 tH1 = t1.lazyProduct(gp.Hm[c]);
       e1(c) = gp.Lm.row(c).dot(v1) + 0.5 * tH1.cwiseProduct(t1).sum();
-      if (c0 != 0.0) {
+      if (need0) {
         const Mat39 tH0 = t0.lazyProduct(gp.Hm[c]);
         e0(c) = gp.Lm.row(c).dot(v0) + 0.5 * tH0.cwiseProduct(t0).sum();
-      }
-      if (same_bar) {
-        Bm.row(c) = gp.Lm.row(c) + Eigen::Map<const Row27>(tH1.data());
-      } else {
-        const Mat39 tHb = tbar.lazyProduct(gp.Hm[c]);
+        const Mat39 tHb = b1 * tH1 + b0 * tH0;
         Bm.row(c) = gp.Lm.row(c) + Eigen::Map<const Row27>(tHb.data());
+      } else {
+        Bm.row(c) = gp.Lm.row(c) + b1 * Eigen::Map<const Row27>(tH1.data());
       }
     }
     const Eigen::Vector3d N = hD1 * (c1 * e1 + c0 * e0);  // N* = h D1 ε*_m (§6.3)
@@ -307,7 +306,7 @@ double CR9Shell::local(const Vec45& u, const Charts& charts, Vec45* uL, Vec45* f
   double U = 0.5 * w.dot(f);
   if (kL) *kL = Kbs_;
   const Mat39 t = translations(w);
-  U += membrane(t, t, 1.0, 0.0, t, &f, kL);
+  U += membrane(t, t, 1.0, 0.0, 1.0, 0.0, &f, kL);
   if (fL) *fL = f;
   return U;
 }
@@ -320,10 +319,10 @@ double CR9Shell::internal(const Vec45& u, const Charts& charts, Vec45* F, Mat45*
   const Mat39 t = translations(w);
   if (K) {
     Mat45 kL = Kbs_;
-    U += membrane(t, t, 1.0, 0.0, t, &fL, &kL);
+    U += membrane(t, t, 1.0, 0.0, 1.0, 0.0, &fL, &kL);
     fr.tangent(kL, fL, opt_.geometric_stiffness, K);  // §3.4 K = T^T k_L T + K_σ
   } else {
-    U += membrane(t, t, 1.0, 0.0, t, &fL, nullptr);
+    U += membrane(t, t, 1.0, 0.0, 1.0, 0.0, &fL, nullptr);
   }
   if (F) *F = fr.apply_transpose(fL);  // §3.4 F = T^T f_L
   return U;
@@ -345,16 +344,15 @@ double CR9Shell::algorithmic_internal(const Vec45& u_n, const Vec45& u_np1, cons
   const Vec45 u_mid = (1.0 - alpha_f) * u_np1 + alpha_f * u_n;
   const CorotationalFrame fr = local_increments(u_mid, charts, nullptr);
   const double c1 = 1.0 - alpha_f + xi, c0 = alpha_f - xi;
-  const Vec45 wbar = (1.0 - alpha_f) * w1 + alpha_f * wn;
   Vec45 fL = Kbs_ * (c1 * w1 + c0 * wn);  // B_b^T M* + B_s^T Q* (B_b, B_s constant)
   double U = 0.5 * w1.dot(Kbs_ * w1);
-  const Mat39 t1 = translations(w1), t0 = translations(wn), tb = translations(wbar);
+  const Mat39 t1 = translations(w1), t0 = translations(wn);  // w̄ = (1-α_f) w1 + α_f wn enters membrane()
   if (K) {
     Mat45 kL = Kbs_;
-    U += membrane(t1, t0, c1, c0, tb, &fL, &kL);
+    U += membrane(t1, t0, c1, c0, 1.0 - alpha_f, alpha_f, &fL, &kL);
     fr.tangent(kL, fL, opt_.geometric_stiffness, K);
   } else {
-    U += membrane(t1, t0, c1, c0, tb, &fL, nullptr);
+    U += membrane(t1, t0, c1, c0, 1.0 - alpha_f, alpha_f, &fL, nullptr);
   }
   if (F) *F = fr.apply_transpose(fL);
   return U;

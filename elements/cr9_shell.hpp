@@ -89,9 +89,9 @@ class CR9Shell {
   using Mat39 = Eigen::Matrix<double, 3, 9>;
 
   // Local response of the membrane part with strains from the local translations t1, t0 weighted by
-  // c1, c0 and strain gradient evaluated at tbar (§6.3; internal(): c1 = 1, c0 = 0, tbar = t1).
+  // c1, c0 and strain gradient evaluated at t̄ = b1 t1 + b0 t0 (§6.3; internal(): c1 = b1 = 1, c0 = b0 = 0).
   // Adds to fL and kL (t rows only); returns the membrane energy at t1.
-  double membrane(const Mat39& t1, const Mat39& t0, double c1, double c0, const Mat39& tbar, Vec45* fL,
+  double membrane(const Mat39& t1, const Mat39& t0, double c1, double c0, double b1, double b0, Vec45* fL,
                   Mat45* kL) const;
   // Local increments w = [t_i, Δθ_i] of u and the frame at u.
   CorotationalFrame local_increments(const Vec45& u, const Charts& charts, Vec45* w) const;

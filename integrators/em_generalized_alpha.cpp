@@ -197,8 +197,7 @@ class NewmarkFamily final : public Integrator {
     auto residual = [&](const double* u, double* r) {
       const Eigen::Map<const Eigen::VectorXd> uu(u, n);
       midpoint_state(u);
-      sys.mass(umid_, charts, M_);
-      sys.inertial(umid_, vmid_, charts, fm_.data());
+      sys.inertia_force(umid_, vmid_, amid_, charts, fm_.data());  // M_mid ü_{n+1−α_m} + F_m,mid
       switch (scheme_) {
         case Scheme::EmGalpha:  // §6.3 strain-averaged internal force
           sys.algorithmic_internal(un_, uu, charts, af, xi_, fint_.data(), nullptr);
@@ -214,8 +213,7 @@ class NewmarkFamily final : public Integrator {
       }
       external_force(u);
       Eigen::Map<Eigen::VectorXd> rr(r, n);
-      multiply(M_.view(), amid_.data(), rr.data());  // M_mid ü_{n+1−α_m}
-      rr += fm_ + fint_ - fext_;                      // = −P̄ (§6.4)
+      rr = fm_ + fint_ - fext_;  // = −P̄ (§6.4)
       zero_constrained(sys.dofs(), r);
       if (!rr.allFinite()) throw std::runtime_error("non-finite residual");
     };

@@ -170,6 +170,23 @@ void Model::inertial(const Eigen::VectorXd& u, const Eigen::VectorXd& v, const s
   });
 }
 
+void Model::inertia_force(const Eigen::VectorXd& u, const Eigen::VectorXd& v, const Eigen::VectorXd& a,
+                          const std::vector<DirectorChart>& charts, double* out) const {
+  std::fill(out, out + num_dofs(), 0.0);
+  for_each_element(assembler_, [&](int e) {
+    CR9Shell::Vec45 ue, ve, ae, fe;
+    CR9Shell::Mat45 me;
+    gather(e, u, ue);
+    gather(e, v, ve);
+    gather(e, a, ae);
+    const auto ch = element_charts(e, charts);
+    elements_[static_cast<size_t>(e)].mass(ue, ch, &me);
+    elements_[static_cast<size_t>(e)].inertial(ue, ve, ch, &fe);
+    fe.noalias() += me * ae;
+    assembler_.add_vector(e, fe, out);
+  });
+}
+
 void Model::external(double t, const Eigen::VectorXd& u, const std::vector<DirectorChart>& charts,
                      double* F) const {
   std::fill(F, F + num_dofs(), 0.0);

@@ -66,6 +66,8 @@ class Model final : public SemiDiscreteSystem {
   void mass(const Eigen::VectorXd& u, const std::vector<DirectorChart>& charts, SparseMatrix& M) const override;
   void inertial(const Eigen::VectorXd& u, const Eigen::VectorXd& v, const std::vector<DirectorChart>& charts,
                 double* Fm) const override;
+  void inertia_force(const Eigen::VectorXd& u, const Eigen::VectorXd& v, const Eigen::VectorXd& a,
+                     const std::vector<DirectorChart>& charts, double* out) const override;
   // F_ext(t, q) (overwrites F). Moments depend on q through p and A1.
   void external(double t, const Eigen::VectorXd& u, const std::vector<DirectorChart>& charts,
                 double* F) const override;

@@ -44,6 +44,10 @@ class SemiDiscreteSystem {
   virtual void mass(const Eigen::VectorXd& u, const std::vector<DirectorChart>& charts, SparseMatrix& M) const = 0;
   virtual void inertial(const Eigen::VectorXd& u, const Eigen::VectorXd& v, const std::vector<DirectorChart>& charts,
                         double* Fm) const = 0;
+  // M(q) a + F_m(q, v) in one pass (overwrites out). The default assembles M; the Model multiplies
+  // element by element, which is what a residual evaluation needs.
+  virtual void inertia_force(const Eigen::VectorXd& u, const Eigen::VectorXd& v, const Eigen::VectorXd& a,
+                             const std::vector<DirectorChart>& charts, double* out) const;
   // F_ext(t, q) (overwrites F).
   virtual void external(double t, const Eigen::VectorXd& u, const std::vector<DirectorChart>& charts,
                         double* F) const = 0;
