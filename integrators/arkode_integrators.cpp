@@ -184,14 +184,7 @@ class ArkodeIntegrator final : public Integrator {
     w_ = y[2 * n_];
   }
 
-  bool in_sync(const State& s) const {
-    if (s.t != t_ || s.u.size() != n_ || s.charts.size() != work_.charts.size()) return false;
-    for (size_t i = 0; i < s.charts.size(); ++i)
-      if (s.charts[i].l != work_.charts[i].l || s.charts[i].n != work_.charts[i].n || s.charts[i].s != work_.charts[i].s)
-        return false;
-    return s.u == Eigen::Map<const Eigen::VectorXd>(data(y_.get()), n_) &&
-           s.v == Eigen::Map<const Eigen::VectorXd>(data(y_.get()) + n_, n_);
-  }
+  bool in_sync(const State& s) const { return state_in_sync(s, t_, work_, data(y_.get()), n_); }
   void restart_from(State& s, StepReport& rep) {
     add_counters(rep);
     t_ = s.t;

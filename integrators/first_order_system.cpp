@@ -98,4 +98,12 @@ void check_tolerances(const std::string& who, double rtol, double atol) {
   }
 }
 
+bool state_in_sync(const State& s, double t, const State& held, const double* y, Index n) {
+  if (s.t != t || s.u.size() != n || s.charts.size() != held.charts.size()) return false;
+  for (size_t i = 0; i < s.charts.size(); ++i)
+    if (s.charts[i].l != held.charts[i].l || s.charts[i].n != held.charts[i].n || s.charts[i].s != held.charts[i].s)
+      return false;
+  return s.u == Eigen::Map<const Eigen::VectorXd>(y, n) && s.v == Eigen::Map<const Eigen::VectorXd>(y + n, n);
+}
+
 }  // namespace shelldyn

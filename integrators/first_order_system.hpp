@@ -63,6 +63,11 @@ class FirstOrderSystem {
 // True if all n values are finite.
 bool all_finite(const double* x, Index n);
 
+// True if `s` is exactly the state an adaptive integrator holds: same time t, same director charts as
+// `held`, and q, v equal to the first 2n entries of y. The caller may re-chart or replace the state
+// between advance() calls; the integrator then re-initializes from it.
+bool state_in_sync(const State& s, double t, const State& held, const double* y, Index n);
+
 // Throws std::invalid_argument("<who>: rtol must be ...") unless 0 < rtol < 1 and 0 < atol < inf
 // (shared settings validation of the baselines).
 void check_tolerances(const std::string& who, double rtol, double atol);
