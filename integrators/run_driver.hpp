@@ -10,8 +10,9 @@
 // and prints one progress line (at most ~5 per second of wall time; the last one always).
 //
 // Energy bookkeeping: total H = K + V − W_ext, with W_ext accumulated by the integrator consistently with
-// its own time discretization. rel_drift = (H − H_ref)/|H_ref|, where H_ref is H at the first output time at
-// or after the loads end (t = 0 for unloaded cases); it is NaN before that. Momentum changes ΔL, ΔJ are
+// its own time discretization. rel_drift = (H − H_ref)/(K + V)_ref, where H_ref and (K + V)_ref are taken at
+// the first output time at or after the loads end (t = 0 for unloaded cases); it is NaN before that. (K + V,
+// not H, is the scale: a body started at rest holds exactly the work done on it, so H_ref ≈ 0.) Momentum changes ΔL, ΔJ are
 // measured from the same reference time.
 //
 // Failure (StepFailure, bad settings, I/O): run.json gets status "incomplete: <reason>", the history and
@@ -48,8 +49,8 @@ struct RunSummary {
   std::string status;              // "complete" or "incomplete: ..."
   double t_end = 0.0;
   StepReport totals;
-  double H0 = 0.0, H_ref = 0.0, t_ref = 0.0, H_final = 0.0;
-  double max_rel_drift = 0.0;      // max |H − H_ref|/|H_ref| for t ≥ t_ref
+  double H0 = 0.0, H_ref = 0.0, E_ref = 0.0, t_ref = 0.0, H_final = 0.0;  // E_ref = (K + V) at t_ref
+  double max_rel_drift = 0.0;      // max |H − H_ref|/E_ref for t ≥ t_ref
   double final_rel_drift = 0.0;
   double max_dL = 0.0, max_dJ = 0.0;          // max ‖L − L_ref‖, ‖J − J_ref‖ for t ≥ t_ref
   double ref_L = 0.0, ref_J = 0.0;            // ‖L_ref‖, ‖J_ref‖
