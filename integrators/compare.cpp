@@ -2,6 +2,7 @@
 
 #include "integrators/integrator.hpp"
 #include "integrators/integrator_settings.hpp"
+#include "lib/case_file.hpp"
 #include "lib/history_writer.hpp"
 #include "lib/problem.hpp"
 
@@ -190,6 +191,7 @@ std::vector<CompareRun> expand_compare_runs(const CompareOptions& o) {
   for (double r : o.rtols)
     if (!(r > 0.0) || !std::isfinite(r)) throw std::invalid_argument("--rtol: every tolerance must be > 0 (got " + num(r) + ")");
   const auto names = integrator_names();
+  const CaseSpec case_spec = load_case(o.case_path);
   std::vector<CompareRun> runs;
   for (const auto& spec : o.specs) {
     CompareRun base = parse_compare_spec(spec);
@@ -201,11 +203,16 @@ std::vector<CompareRun> expand_compare_runs(const CompareOptions& o) {
     }
     if (base.integrator == "static")
       throw std::invalid_argument("integrator setting '" + spec + "': 'static' is not a time integrator");
-    {  // adaptive = has an rtol setting
+    {  // adaptive = has an rtol setting; inherited = the case's settings this integrator understands
       IntegratorSettings probe(base.integrator, {});
       const auto integ = make_integrator(probe, 1e-3);
-      for (const auto& [k, v] : integ->settings())
-        if (k == "rtol") base.adaptive = true;
+      std::set<std::string> known;
+      for (const auto& [k, v] : integ->settings()) known.insert(k);
+      base.adaptive = known.count("rtol") > 0;
+      for (const auto& [k, v] : case_spec.integrator.settings) {
+        const bool overridden = std::any_of(base.overrides.begin(), base.overrides.end(), [&](const auto& kv) { return kv.first == k; });
+        if (known.count(k) && k != "dt" && !overridden) base.inherited.emplace_back(k, v);
+      }
     }
     const bool has_rtol = std::any_of(base.overrides.begin(), base.overrides.end(), [](const auto& kv) { return kv.first == "rtol"; });
     std::vector<CompareRun> expanded;
@@ -226,7 +233,9 @@ std::vector<CompareRun> expand_compare_runs(const CompareOptions& o) {
     }
     for (auto& x : expanded) {
       // Check every setting now: a typo must stop the study before hours are spent on it.
-      IntegratorSettings check(x.integrator, x.overrides, "integrator setting '" + spec + "'");
+      auto all = x.inherited;
+      all.insert(all.end(), x.overrides.begin(), x.overrides.end());
+      IntegratorSettings check(x.integrator, all, "integrator setting '" + spec + "'");
       try {
         make_integrator(check, x.dt > 0.0 ? x.dt : 1e-3);
       } catch (const std::exception& e) {
@@ -287,7 +296,8 @@ CompareResult run_comparison(const CompareOptions& o) {
         RunOptions ro;
         ro.out_dir = row.out_dir;
         ro.integrator = runs[k].integrator;
-        ro.settings = runs[k].overrides;
+        ro.settings = runs[k].inherited;
+        ro.settings.insert(ro.settings.end(), runs[k].overrides.begin(), runs[k].overrides.end());
         ro.dt = runs[k].dt;
         ro.t_end = o.t_end;
         ro.output_interval = o.output_interval;
@@ -392,6 +402,9 @@ CompareResult run_comparison(const CompareOptions& o) {
     md << "# Integrator comparison: " << first.spec.name << "\n\n";
     md << "- case: `" << o.case_path << "` (" << first.spec.description << ")\n";
     md << "- command: `" << o.command << "`\n";
+    md << "- case integrator settings, inherited by every run whose integrator understands them: "
+       << (first.spec.integrator.settings.empty() ? std::string("none") : settings_text(first.spec.integrator.settings, ", "))
+       << " (full settings per run: summary.csv, <run>/run.json)\n";
     md << "- end time " << num(t_end) << " s; loads end at " << num(loads_end) << " s"
        << (t_end < loads_end ? " (after t_end: no energy-conservation figures)" : "") << "\n";
     md << "- energy error: max |H − H_ref|/(K_ref + V_ref) after the loads end (H = K + V − W_ext; ref = first output at "

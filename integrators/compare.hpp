@@ -12,6 +12,11 @@
 // integrator with its defaults) and does not set rtol itself. Labels (folder and row names) are
 // run_label-style: NAME then _KEY=VALUE per override, e.g. "galpha_rho_inf=0.8_dt=0.002".
 //
+// Fairness: every run inherits those settings of the case's `integrator:` block that its integrator
+// understands (e.g. newton, linear_solver, cc_tol, rho_inf; probed from the integrator's defaults), so
+// runs differ only in their integrator and what their spec says; spec overrides win. They are recorded
+// in run.json and summary.csv (`settings`), not in the labels.
+//
 // Execution: `jobs` runs at a time in worker threads, each with its own Problem (case loaded anew) and
 // OpenMP threads = 1 when jobs > 1. Each run writes DIR/<label>/{history.csv,run.json,log.txt[,fields]}.
 // A run that throws is a row with status "failed: <reason>", never dropped.
@@ -57,7 +62,8 @@ struct CompareOptions {
 struct CompareRun {
   std::string label;                // folder and row name
   std::string integrator;
-  std::vector<std::pair<std::string, std::string>> overrides;  // integrator-setting overrides
+  std::vector<std::pair<std::string, std::string>> overrides;  // integrator-setting overrides (spec)
+  std::vector<std::pair<std::string, std::string>> inherited;  // from the case's integrator block
   double dt = 0.0;                  // 0: the case's
   bool adaptive = false;            // integrator has an rtol setting
 };
