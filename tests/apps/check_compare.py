@@ -1,7 +1,10 @@
 #!/usr/bin/python3
 """Checks what `shelldyn compare` wrote.
 
-usage: check_compare.py COMPARE_DIR [--conserving LABEL,...] EXPECTED_LABEL...
+usage: check_compare.py COMPARE_DIR [--conserving LABEL,...] [--failed LABEL,...] EXPECTED_LABEL...
+
+--before-loads-end: the study ends before the loads do, so every energy error must be NaN ("n/a").
+--failed: these runs must be rows with status "failed: <reason>" (not dropped); the others complete.
 
 - summary.csv: one row per expected label (in order), status complete, steps > 0, wall_s > 0, finite energy
   error, linear momentum change max_dL below 1e-9 |L_ref| for the --conserving runs (rho_inf = 1; with
@@ -26,8 +29,13 @@ def fail(msg):
 
 def main():
     d, labels, conserving = sys.argv[1], sys.argv[2:], []
-    if labels and labels[0] == "--conserving":
-        conserving, labels = labels[1].split(","), labels[2:]
+    failed, energy = [], True
+    while labels and labels[0] in ("--conserving", "--failed", "--before-loads-end"):
+        if labels[0] == "--before-loads-end":  # t_end before the loads end: energy error is n/a (NaN)
+            energy, labels = False, labels[1:]
+            continue
+        (conserving if labels[0] == "--conserving" else failed).extend(labels[1].split(","))
+        labels = labels[2:]
     with open(os.path.join(d, "summary.csv"), newline="", encoding="utf-8") as f:
         rows = list(csv.DictReader(f))
     if [r["label"] for r in rows] != labels:
@@ -35,11 +43,15 @@ def main():
     refs = set()
     for r in rows:
         lab = r["label"]
+        if lab in failed:
+            if not r["status"].startswith("failed: ") or len(r["status"]) < 20:
+                fail(f"{lab}: status {r['status']!r}, expected 'failed: <reason>'")
+            continue
         if r["status"] != "complete":
             fail(f"{lab}: status {r['status']!r}")
         if int(r["steps"]) <= 0 or float(r["wall_s"]) <= 0:
             fail(f"{lab}: steps {r['steps']}, wall_s {r['wall_s']}")
-        if not math.isfinite(float(r["energy_error"])):
+        if math.isfinite(float(r["energy_error"])) != energy:
             fail(f"{lab}: energy_error {r['energy_error']}")
         if lab in conserving and float(r["max_dL"]) > 1e-9 * max(1.0, float(r["norm_L_ref"])):
             fail(f"{lab}: linear momentum not conserved after the loads: max_dL {r['max_dL']}")
@@ -57,6 +69,9 @@ def main():
         fail(f"runs with zero displacement error {refs}, reference {rows[0]['reference']!r}")
     with open(os.path.join(d, "summary.md"), encoding="utf-8") as f:
         md = f.read()
+    for lab in failed:
+        if f"| `{lab}` |" not in md or "failed: " not in md:
+            fail(f"summary.md lacks the failed row {lab}")
     for lab in labels:
         if f"| `{lab}` |" not in md:
             fail(f"summary.md lacks a row for {lab}")
