@@ -204,14 +204,10 @@ std::vector<CompareRun> expand_compare_runs(const CompareOptions& o) {
     if (base.integrator == "static")
       throw std::invalid_argument("integrator setting '" + spec + "': 'static' is not a time integrator");
     {  // adaptive = has an rtol setting; inherited = the case's settings this integrator understands
-      IntegratorSettings probe(base.integrator, {});
-      const auto integ = make_integrator(probe, 1e-3);
-      std::set<std::string> known;
-      for (const auto& [k, v] : integ->settings()) known.insert(k);
-      base.adaptive = known.count("rtol") > 0;
-      for (const auto& [k, v] : case_spec.integrator.settings) {
+      base.adaptive = !settings_understood_by(base.integrator, {{"rtol", ""}}).empty();
+      for (const auto& [k, v] : settings_understood_by(base.integrator, case_spec.integrator.settings)) {
         const bool overridden = std::any_of(base.overrides.begin(), base.overrides.end(), [&](const auto& kv) { return kv.first == k; });
-        if (known.count(k) && k != "dt" && !overridden) base.inherited.emplace_back(k, v);
+        if (!overridden) base.inherited.emplace_back(k, v);
       }
     }
     const bool has_rtol = std::any_of(base.overrides.begin(), base.overrides.end(), [](const auto& kv) { return kv.first == "rtol"; });

@@ -18,7 +18,7 @@
 //   rho_inf [1], xi [0] (em-galpha), beta [0.25] and gamma [0.5] (newmark),
 //   newton: full|modified [full] (modified: refresh K̄ every setup_every [20] iterations;
 //   a step that fails is retried with full Newton), linear_solver: eigen-ldlt|cholmod|klu [eigen-ldlt],
-//   cc_tol [1e-12] (paper eq. 39 energy ratio; the paper uses 1e-6), step_tol [1e-14], min_iters [1], max_iters [25],
+//   cc_tol [1e-12; 1e-20 with modified Newton] (paper eq. 39 energy ratio; the paper uses 1e-6), step_tol [1e-14], min_iters [1], max_iters [25],
 //   max_cuts [0] (step cutting: a failed step is retried as two half steps, recursively), hysteresis [1].
 #pragma once
 

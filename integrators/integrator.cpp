@@ -55,6 +55,22 @@ std::vector<std::pair<std::string, std::string>> integrator_catalogue() {
   return out;
 }
 
+std::vector<std::pair<std::string, std::string>> settings_understood_by(
+    const std::string& name, const std::vector<std::pair<std::string, std::string>>& settings) {
+  IntegratorSettings probe(name, {});
+  const auto integrator = make_integrator(probe, 1e-3);
+  std::vector<std::pair<std::string, std::string>> out;
+  for (const auto& [key, value] : settings) {
+    if (key == "dt") continue;
+    for (const auto& [known, unused] : integrator->settings())
+      if (known == key) {
+        out.emplace_back(key, value);
+        break;
+      }
+  }
+  return out;
+}
+
 std::unique_ptr<Integrator> make_integrator(IntegratorSettings& settings, double dt) {
   const auto it = registry().find(settings.name());
   if (it == registry().end()) {

@@ -68,6 +68,12 @@ class Integrator {
 // registered names when the name is unknown.
 std::unique_ptr<Integrator> make_integrator(IntegratorSettings& settings, double dt);
 
+// The entries of `settings` (e.g. a case file's integrator block) that integrator `name` understands, i.e.
+// whose keys appear among its resolved settings ("dt" excepted). Lets a run with another integrator keep
+// the case's solver settings (newton, linear_solver, ...) that still apply, and drop the rest.
+std::vector<std::pair<std::string, std::string>> settings_understood_by(
+    const std::string& name, const std::vector<std::pair<std::string, std::string>>& settings);
+
 // Names of every registered integrator, for --help and error messages.
 std::vector<std::string> integrator_names();
 

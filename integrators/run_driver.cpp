@@ -61,9 +61,12 @@ RunSummary run_dynamic(Problem& problem, const RunOptions& o) {
   if (!(t_end >= 0.0) || !std::isfinite(t_end)) throw std::invalid_argument("t_end must be >= 0 (got " + std::to_string(t_end) + ")");
   if (out_dt < dt) out_dt = dt;
   const int vtu_every = o.vtu_every >= 0 ? o.vtu_every : (spec.output.vtu ? spec.output.vtu_every : 0);
+  // Another integrator than the case's keeps the case settings it understands (as `shelldyn compare` does).
   IntegratorSettings settings = o.integrator.empty() || o.integrator == spec.integrator.name
                                     ? IntegratorSettings(spec.integrator)
-                                    : IntegratorSettings(o.integrator, {});
+                                    : IntegratorSettings(o.integrator, o.integrator == "static"
+                                                                           ? std::vector<std::pair<std::string, std::string>>{}
+                                                                           : settings_understood_by(o.integrator, spec.integrator.settings));
   for (const auto& [k, v] : o.settings) settings.set(k, v);
   if (settings.name() == "static")
     throw std::invalid_argument("integrator 'static' is the static solver: use `shelldyn static CASE`");
