@@ -89,3 +89,33 @@ TEST(StaticBenchmarks, SzePinchedHemisphere) {
 
 }  // namespace
 }  // namespace shelldyn
+
+namespace shelldyn {
+namespace {
+
+TEST(StaticSolver, GivesUpWithAClearErrorAndCutsIncrementsBeforeThat) {
+  // One Newton iteration per attempt cannot converge: every increment is cut until min_increment.
+  CaseSpec spec = load_case(case_path("sze-cantilever-shear.yaml"));
+  spec.integrator.settings = {{"max_iters", "1"}, {"min_increment", "0.01"}};
+  Problem p = make_problem(spec);
+  try {
+    run_static(p, "", nullptr);
+    FAIL() << "expected the static solver to give up";
+  } catch (const std::runtime_error& e) {
+    const std::string msg = e.what();
+    EXPECT_NE(msg.find("gave up at load factor 0"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("min_increment"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("KIN_MAXITER_REACHED"), std::string::npos) << msg;
+  }
+  // With enough iterations but a large first increment, cutting and regrowth still reach the end.
+  spec.integrator.settings = {{"increment", "1.0"}, {"max_iters", "8"}};
+  Problem q = make_problem(spec);
+  StaticReport report;
+  const auto rows = run_static(q, "", nullptr, &report);
+  EXPECT_GT(report.failed_attempts, 0);
+  EXPECT_NEAR(rows.back().load_factor, 1.0, 1e-12);
+  EXPECT_NEAR(-rows.back().monitors[0], 3.3162, 2e-3);  // same answer as with 20 increments
+}
+
+}  // namespace
+}  // namespace shelldyn
