@@ -5,6 +5,7 @@
 #pragma once
 
 #include "integrators/integrator.hpp"
+#include "tests/integrators/dynamics_fixtures.hpp"
 #include "lib/mesh_generators.hpp"
 #include "lib/model.hpp"
 #include "lib/nodal_normals.hpp"
@@ -18,12 +19,7 @@ namespace shelldyn {
 namespace baseline_cases {
 
 // A free rectangular plate a × b (centroid at the origin, normal +Z) of nx × ny CR9 elements.
-inline std::unique_ptr<Model> free_plate(double a, double b, int nx, int ny, const ShellMaterial& mat) {
-  Mesh mesh = make_rectangle(a, b, nx, ny, -0.5 * a, -0.5 * b);
-  auto normals = initial_normals(mesh);
-  DofMap dofs(mesh.num_nodes());
-  return std::make_unique<Model>(std::move(mesh), std::move(normals), mat, std::move(dofs));
-}
+using testing::free_plate;
 
 // Sets the velocity of node i from a translational velocity d and a director rate pdot (converted
 // to the two minor-component rates of the node's chart: q̇ = S ṗ, spec/element.md §2.3).
