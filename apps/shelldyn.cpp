@@ -26,6 +26,7 @@
 #include "lib/case_file.hpp"
 #include "lib/discretization.hpp"
 #include "lib/run_info.hpp"
+#include "lib/state_output.hpp"
 #include "lib/vtu_writer.hpp"
 
 #include <CLI/CLI.hpp>
@@ -156,9 +157,7 @@ int run_check(const CheckOptions& o) {
   print_summary(std::cout, spec, d);
 
   const fs::path dir = o.out_dir.empty() ? fs::path("results") / spec.name : fs::path(o.out_dir);
-  std::error_code ec;
-  fs::create_directories(dir / "fields", ec);
-  if (ec) throw std::runtime_error(dir.string() + ": cannot create the result folder: " + ec.message());
+  prepare_output_folder(dir.string());
   const std::string vtu = "fields/" + vtu_step_file_name(0);
   write_vtu((dir / vtu).string(), d.mesh, initial_fields(d));
   PvdWriter pvd((dir / "fields.pvd").string());
