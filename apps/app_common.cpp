@@ -1,9 +1,10 @@
 #include "apps/app_common.hpp"
 
-#include "integrators/compare.hpp"
+#include "integrators/runs/compare.hpp"
+#include "integrators/runs/registry.hpp"
 #include "integrators/integrator.hpp"
 #include "integrators/integrator_settings.hpp"
-#include "integrators/run_driver.hpp"
+#include "integrators/runs/run_driver.hpp"
 
 #include <Eigen/Dense>
 #include <Eigen/SparseCholesky>

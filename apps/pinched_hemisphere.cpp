@@ -24,8 +24,8 @@
 // self-equilibrated); with em-galpha (rho_inf = 1, xi = 0) H stays constant after 0.03 s up to the
 // time-discretization error.
 #include "apps/app_common.hpp"
-#include "integrators/compare.hpp"
-#include "integrators/run_driver.hpp"
+#include "integrators/runs/compare.hpp"
+#include "integrators/runs/run_driver.hpp"
 
 #include <cmath>
 #include <iostream>

@@ -18,11 +18,12 @@
 // add_check_command: it registers its options and, in its callback, stores the action to run.
 // main() stays unchanged apart from one call.
 #include "apps/app_common.hpp"
-#include "integrators/compare.hpp"
+#include "integrators/runs/compare.hpp"
+#include "integrators/runs/registry.hpp"
 #include "integrators/integrator.hpp"
-#include "integrators/run_driver.hpp"
-#include "integrators/static_run.hpp"
-#include "integrators/sundials_info.hpp"
+#include "integrators/runs/run_driver.hpp"
+#include "integrators/runs/static_run.hpp"
+#include "integrators/sundials/sundials_info.hpp"
 #include "lib/case_file.hpp"
 #include "lib/discretization.hpp"
 #include "lib/run_info.hpp"
@@ -279,7 +280,7 @@ void add_static_command(CLI::App& app, Action& action, const std::string& comman
 
 // --- compare -----------------------------------------------------------------------------------------
 // `shelldyn compare CASE --integrators A,B:KEY=VALUE,... [--dt LIST] [--rtol LIST]`: the comparison
-// study of integrators/compare.hpp (spec syntax, sweeps, reference run and error measures are documented
+// study of integrators/runs/compare.hpp (spec syntax, sweeps, reference run and error measures are documented
 // there), then scripts/plot_compare.py. Exit 0 when every run completed, 3 when some failed (they are
 // rows with status "failed: ..." in summary.csv/summary.md), 1 for bad input.
 struct CompareCommandOptions {

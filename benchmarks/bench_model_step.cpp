@@ -8,7 +8,8 @@
 // matrix, one factorization of K̄ per linear solver, and ms per time step with full and modified Newton
 // for each linear solver on 1 and 2 threads. Run with OPENBLAS_NUM_THREADS=1. Timings are wall time;
 // on a shared 2-core machine compare ratios within one run.
-#include "integrators/em_generalized_alpha.hpp"
+#include "integrators/newmark/em_generalized_alpha.hpp"
+#include "integrators/runs/registry.hpp"
 #include "lib/linear_solver.hpp"
 #include "lib/problem.hpp"
 

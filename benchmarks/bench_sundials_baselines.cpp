@@ -12,8 +12,8 @@
 // Columns: steps (accepted), rejected attempts, RHS/residual evaluations, Newton iterations, linear
 // setups, numeric factorizations, chart events / reinitializations, wall time, and the final errors
 // |ΔH|/H₀ (H = K + V − W_ext), |Δ|J||/|J₀|, and for R2 the errors of K and |J| against the exact values.
-#include "integrators/arkode_integrators.hpp"
-#include "integrators/ida_bdf.hpp"
+#include "integrators/baselines/arkode_integrators.hpp"
+#include "integrators/baselines/ida_bdf.hpp"
 #include "lib/problem.hpp"
 #include "tests/integrators/baseline_cases.hpp"
 

@@ -1,31 +1,6 @@
 #include "integrators/integrator.hpp"
 
-#include "integrators/arkode_integrators.hpp"
-#include "integrators/em_generalized_alpha.hpp"
-#include "integrators/ida_bdf.hpp"
-
-#include <map>
-
 namespace shelldyn {
-namespace {
-struct Entry {
-  IntegratorFactory factory;
-  std::string summary;
-};
-// The registry: one line per integrator.
-const std::map<std::string, Entry>& registry() {
-  static const std::map<std::string, Entry> r = {
-      {"em-galpha", {make_em_galpha, "energy-momentum generalized-alpha of Li & Qian (2025): strain-averaged internal force"}},
-      {"galpha", {make_galpha, "Chung-Hulbert generalized-alpha: alpha_f-weighted end-point internal forces"}},
-      {"midpoint", {make_midpoint, "generalized midpoint: internal force at the midpoint configuration (no strain averaging)"}},
-      {"newmark", {make_newmark, "Newmark (beta, gamma): forces at t_{n+1}"}},
-      {"ida-bdf", {make_ida_bdf, "SUNDIALS IDA variable-order BDF on the residual form with M(q) (adaptive)"}},
-      {"arkode-erk", {make_arkode_erk, "SUNDIALS ARKStep explicit RK, M(q) factorized per RHS (adaptive or fixed)"}},
-      {"arkode-dirk", {make_arkode_dirk, "SUNDIALS ARKStep ESDIRK, Schur-complement Newton matrix M + gamma^2 K (adaptive or fixed)"}},
-  };
-  return r;
-}
-}  // namespace
 
 void StepReport::accumulate(const StepReport& r) {
   steps += r.steps;
@@ -41,46 +16,6 @@ void StepReport::accumulate(const StepReport& r) {
   energy_ratio = r.energy_ratio;
   if (r.steps > 0) last_dt = r.last_dt;
   wall_seconds += r.wall_seconds;
-}
-
-std::vector<std::string> integrator_names() {
-  std::vector<std::string> names;
-  for (const auto& kv : registry()) names.push_back(kv.first);
-  return names;
-}
-
-std::vector<std::pair<std::string, std::string>> integrator_catalogue() {
-  std::vector<std::pair<std::string, std::string>> out;
-  for (const auto& kv : registry()) out.emplace_back(kv.first, kv.second.summary);
-  return out;
-}
-
-std::vector<std::pair<std::string, std::string>> settings_understood_by(
-    const std::string& name, const std::vector<std::pair<std::string, std::string>>& settings) {
-  IntegratorSettings probe(name, {});
-  const auto integrator = make_integrator(probe, 1e-3);
-  std::vector<std::pair<std::string, std::string>> out;
-  for (const auto& [key, value] : settings) {
-    if (key == "dt") continue;
-    for (const auto& [known, unused] : integrator->settings())
-      if (known == key) {
-        out.emplace_back(key, value);
-        break;
-      }
-  }
-  return out;
-}
-
-std::unique_ptr<Integrator> make_integrator(IntegratorSettings& settings, double dt) {
-  const auto it = registry().find(settings.name());
-  if (it == registry().end()) {
-    std::string names;
-    for (const auto& n : integrator_names()) names += (names.empty() ? "" : ", ") + n;
-    throw std::invalid_argument("unknown integrator '" + settings.name() + "' (available: " + names + ")");
-  }
-  auto integrator = it->second.factory(settings, dt);
-  settings.finish();
-  return integrator;
 }
 
 }  // namespace shelldyn

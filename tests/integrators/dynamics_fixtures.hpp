@@ -3,7 +3,7 @@
 // spec/benchmarks.md §6.
 #pragma once
 
-#include "integrators/em_generalized_alpha.hpp"
+#include "integrators/newmark/em_generalized_alpha.hpp"
 #include "lib/mesh_generators.hpp"
 #include "lib/model.hpp"
 #include "lib/nodal_normals.hpp"

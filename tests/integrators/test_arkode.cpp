@@ -1,5 +1,5 @@
-// arkode-erk / arkode-dirk (integrators/arkode_integrators.hpp): ARKStep on ẏ = [v; M(q)⁻¹(...); F_ext·v].
-#include "integrators/arkode_integrators.hpp"
+// arkode-erk / arkode-dirk (integrators/baselines/arkode_integrators.hpp): ARKStep on ẏ = [v; M(q)⁻¹(...); F_ext·v].
+#include "integrators/baselines/arkode_integrators.hpp"
 
 #include "tests/integrators/baseline_cases.hpp"
 

@@ -2,7 +2,8 @@
 // 12–14; spec/benchmarks.md §6): spectral radii on a linear oscillator, conservation in free flight,
 // dissipation, director-chart switching, rigid spins, the discrete energy balance under load, and what the
 // strain averaging buys on a stiff free-flying plate.
-#include "integrators/em_generalized_alpha.hpp"
+#include "integrators/newmark/em_generalized_alpha.hpp"
+#include "integrators/runs/registry.hpp"
 
 #include "dynamics_fixtures.hpp"
 

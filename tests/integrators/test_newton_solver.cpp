@@ -1,8 +1,8 @@
-// KINSOL-driven NewtonSolver (integrators/newton_solver.hpp) on the 2-D Bratu problem
+// KINSOL-driven NewtonSolver (integrators/nonlinear/newton_solver.hpp) on the 2-D Bratu problem
 //   F_i(u) = (4 u_i − Σ_neighbours u_j) / h² − λ e^{u_i} = 0   on an m x m interior grid, u = 0 outside,
 // whose Jacobian (5-point Laplacian/h² − λ diag e^u) is sparse and symmetric, and SPD for λ below
 // the fold (λ ≈ 6.8).
-#include "integrators/newton_solver.hpp"
+#include "integrators/nonlinear/newton_solver.hpp"
 
 #include <gtest/gtest.h>
 

@@ -1,6 +1,6 @@
 // Nonlinear static validation of the CR9 element against Sze, Liu & Lo (2004) (spec/benchmarks.md §4),
 // run from the case files in apps/cases/ exactly as `shelldyn static` runs them.
-#include "integrators/static_run.hpp"
+#include "integrators/runs/static_run.hpp"
 
 #include <gtest/gtest.h>
 

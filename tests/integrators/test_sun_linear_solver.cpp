@@ -1,6 +1,6 @@
-// The custom SUNLinearSolver (integrators/sun_linear_solver.hpp): ops called directly, then inside
+// The custom SUNLinearSolver (integrators/sundials/sun_linear_solver.hpp): ops called directly, then inside
 // IDA (the KINSOL use is covered by test_newton_solver.cpp).
-#include "integrators/sun_linear_solver.hpp"
+#include "integrators/sundials/sun_linear_solver.hpp"
 
 #include <gtest/gtest.h>
 

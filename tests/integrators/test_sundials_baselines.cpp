@@ -2,6 +2,7 @@
 // chart events under adaptive stepping on the rigid spin R2 (spec/benchmarks.md §6), agreement on the
 // free flight of spec/element.md §7 item 12, and energy drift against the tolerance.
 #include "integrators/integrator.hpp"
+#include "integrators/runs/registry.hpp"
 
 #include "tests/integrators/baseline_cases.hpp"
 

@@ -1,6 +1,6 @@
 // Newton solver for F(u) = 0 with a sparse symmetric Jacobian on a fixed pattern: KINSOL (SUNDIALS
 // 6.4.1) does the Newton iterations, the linear systems go through a shelldyn::LinearSolver wrapped
-// as a custom SUNLinearSolver (integrators/sun_linear_solver.hpp). Used by every implicit scheme of
+// as a custom SUNLinearSolver (integrators/sundials/sun_linear_solver.hpp). Used by every implicit scheme of
 // the project, in particular the energy-momentum generalized-α scheme (spec/element.md §6).
 //
 // HOW THE ITERATION IS DRIVEN (design decision)

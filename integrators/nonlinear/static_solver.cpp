@@ -1,4 +1,4 @@
-#include "integrators/static_solver.hpp"
+#include "integrators/nonlinear/static_solver.hpp"
 
 #include <algorithm>
 #include <chrono>

@@ -1,4 +1,4 @@
-#include "integrators/first_order_system.hpp"
+#include "integrators/baselines/first_order_system.hpp"
 
 #include "lib/assembler.hpp"
 

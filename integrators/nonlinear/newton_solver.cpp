@@ -1,9 +1,9 @@
 // KINSOL-driven Newton solver; the design (one KINSol call per iteration, residual cache, setup
 // control, stopping tests) is explained in the header.
-#include "integrators/newton_solver.hpp"
+#include "integrators/nonlinear/newton_solver.hpp"
 
-#include "integrators/sun_linear_solver.hpp"
-#include "integrators/sundials_support.hpp"
+#include "integrators/sundials/sun_linear_solver.hpp"
+#include "integrators/sundials/sundials_support.hpp"
 
 #include <kinsol/kinsol.h>
 #include <kinsol/kinsol_ls.h>

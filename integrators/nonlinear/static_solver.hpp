@@ -9,7 +9,7 @@
 // the last converged state; after easy increments the increment grows again, up to the initial size.
 #pragma once
 
-#include "integrators/newton_solver.hpp"
+#include "integrators/nonlinear/newton_solver.hpp"
 #include "lib/model.hpp"
 #include "lib/state.hpp"
 

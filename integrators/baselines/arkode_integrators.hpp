@@ -1,5 +1,5 @@
 // `arkode-erk` and `arkode-dirk`: SUNDIALS ARKStep (explicit / diagonally implicit Runge–Kutta) on the
-// first-order form of the shell semi-discretization (integrators/first_order_system.hpp), y = [q; v; w]:
+// first-order form of the shell semi-discretization (integrators/baselines/first_order_system.hpp), y = [q; v; w]:
 //
 //     ẏ = f(t, y) = [ v ;  M(q)⁻¹ (F_ext − F_int − F_m) ;  F_ext·v ]
 //

@@ -1,6 +1,7 @@
-#include "integrators/run_driver.hpp"
+#include "integrators/runs/run_driver.hpp"
+#include "integrators/runs/registry.hpp"
 
-#include "integrators/sundials_info.hpp"
+#include "integrators/sundials/sundials_info.hpp"
 #include "lib/history_writer.hpp"
 #include "lib/run_info.hpp"
 #include "lib/state_output.hpp"

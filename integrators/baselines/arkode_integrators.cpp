@@ -1,7 +1,7 @@
-#include "integrators/arkode_integrators.hpp"
+#include "integrators/baselines/arkode_integrators.hpp"
 
-#include "integrators/first_order_system.hpp"
-#include "integrators/sundials_support.hpp"
+#include "integrators/baselines/first_order_system.hpp"
+#include "integrators/sundials/sundials_support.hpp"
 #include "lib/assembler.hpp"
 
 #include <cstdio>  // arkode_butcher.h uses FILE without including it (stack.md §2.2)

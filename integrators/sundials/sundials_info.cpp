@@ -1,4 +1,4 @@
-#include "integrators/sundials_info.hpp"
+#include "integrators/sundials/sundials_info.hpp"
 
 #include <sundials/sundials_version.h>
 

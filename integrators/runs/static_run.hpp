@@ -2,7 +2,7 @@
 // (static.csv, fields/ VTU series + fields.pvd, run.json) and a one-line progress report per increment.
 #pragma once
 
-#include "integrators/static_solver.hpp"
+#include "integrators/nonlinear/static_solver.hpp"
 #include "lib/problem.hpp"
 
 #include <ostream>

@@ -21,7 +21,7 @@
 // symmetric: use "klu" there.
 #pragma once
 
-#include "integrators/sundials_support.hpp"
+#include "integrators/sundials/sundials_support.hpp"
 #include "lib/linear_solver.hpp"
 
 #include <functional>

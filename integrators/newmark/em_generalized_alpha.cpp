@@ -1,6 +1,6 @@
-#include "integrators/em_generalized_alpha.hpp"
+#include "integrators/newmark/em_generalized_alpha.hpp"
 
-#include "integrators/newton_solver.hpp"
+#include "integrators/nonlinear/newton_solver.hpp"
 #include "lib/assembler.hpp"
 #include "lib/linear_solver.hpp"
 

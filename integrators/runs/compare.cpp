@@ -1,4 +1,5 @@
-#include "integrators/compare.hpp"
+#include "integrators/runs/compare.hpp"
+#include "integrators/runs/registry.hpp"
 
 #include "integrators/integrator.hpp"
 #include "integrators/integrator_settings.hpp"

@@ -1,8 +1,8 @@
-#include "integrators/ida_bdf.hpp"
+#include "integrators/baselines/ida_bdf.hpp"
 
-#include "integrators/first_order_system.hpp"
-#include "integrators/sun_linear_solver.hpp"
-#include "integrators/sundials_support.hpp"
+#include "integrators/baselines/first_order_system.hpp"
+#include "integrators/sundials/sun_linear_solver.hpp"
+#include "integrators/sundials/sundials_support.hpp"
 #include "lib/assembler.hpp"
 
 #include <ida/ida.h>

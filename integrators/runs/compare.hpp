@@ -33,7 +33,7 @@
 // unreadable case throw std::invalid_argument / std::runtime_error before any run starts.
 #pragma once
 
-#include "integrators/run_driver.hpp"
+#include "integrators/runs/run_driver.hpp"
 
 #include <limits>
 #include <ostream>

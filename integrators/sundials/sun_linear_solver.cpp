@@ -1,4 +1,4 @@
-#include "integrators/sun_linear_solver.hpp"
+#include "integrators/sundials/sun_linear_solver.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -1,5 +1,5 @@
 // `ida-bdf`: SUNDIALS IDA (variable-order, variable-step BDF) on the residual form of the shell
-// semi-discretization (integrators/first_order_system.hpp), y = [q; v; w]:
+// semi-discretization (integrators/baselines/first_order_system.hpp), y = [q; v; w]:
 //
 //     F(t, y, ẏ) = [ q̇ − v ;  M(q) v̇ + F_m(q, v) + F_int(q) − F_ext(t, q) ;  ẇ − F_ext·v ]
 //

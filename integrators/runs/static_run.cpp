@@ -1,7 +1,7 @@
-#include "integrators/static_run.hpp"
+#include "integrators/runs/static_run.hpp"
 
 #include "integrators/integrator_settings.hpp"
-#include "integrators/sundials_info.hpp"
+#include "integrators/sundials/sundials_info.hpp"
 #include "lib/run_info.hpp"
 #include "lib/state_output.hpp"
 

@@ -1,4 +1,4 @@
-#include "integrators/sundials_support.hpp"
+#include "integrators/sundials/sundials_support.hpp"
 
 #include <algorithm>
 #include <cstdlib>
