@@ -19,6 +19,7 @@
 
 #include <memory>
 #include <stdexcept>
+#include <ostream>
 #include <string>
 #include <utility>
 #include <vector>
@@ -60,6 +61,10 @@ class Integrator {
 
   // External work done on the system since initialize(), evaluated consistently with the scheme.
   virtual double external_work() const = 0;
+
+  // Where to print progress lines while advance() runs long (adaptive integrators between output times);
+  // null: none. The default ignores it.
+  virtual void set_progress_log(std::ostream* /*log*/, const std::string& /*label*/) {}
 };
 
 }  // namespace shelldyn

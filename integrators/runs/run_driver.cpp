@@ -11,6 +11,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <ctime>
 #include <limits>
 #include <memory>
 
@@ -44,6 +45,14 @@ void fill_summary_json(JsonFields& j, const RunSummary& s) {
   j.set("max_strain_over_energy", s.max_strain_ratio);
   for (const auto& [name, value] : s.final_monitors) j.set("final_" + name, value);
   j.set("wall_s", s.wall_seconds);
+  j.set("cpu_s", s.cpu_seconds);
+}
+
+// CPU seconds of this thread (single-threaded runs: several may share the process) or of the process.
+double cpu_now(bool thread_only) {
+  timespec ts{};
+  clock_gettime(thread_only ? CLOCK_THREAD_CPUTIME_ID : CLOCK_PROCESS_CPUTIME_ID, &ts);
+  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
 }
 
 }  // namespace
@@ -53,6 +62,8 @@ RunSummary run_dynamic(Problem& problem, const RunOptions& o) {
   CaseSpec& spec = problem.spec;
   Model& model = *problem.model;
   if (o.threads > 0) omp_set_num_threads(o.threads);
+  const bool thread_cpu = omp_get_max_threads() == 1;
+  const double cpu0 = cpu_now(thread_cpu);
 
   // --- resolve settings ---------------------------------------------------------------------------
   const double dt = o.dt > 0.0 ? o.dt : spec.time.dt;
@@ -109,7 +120,11 @@ RunSummary run_dynamic(Problem& problem, const RunOptions& o) {
 
   // --- state and reference quantities ----------------------------------------------------------------
   State state = problem.initial_state();
+  integrator->set_progress_log(o.log, o.label.empty() ? sum.integrator : o.label);
   integrator->initialize(model, state);
+  // Integrators may resolve settings at initialize() (e.g. the baselines' absolute tolerances): report those.
+  sum.settings = integrator->settings();
+  spec.integrator.settings = sum.settings;
   const double loads_end = model.loads_end();
   bool have_ref = false;
   Eigen::Vector3d L_ref = Eigen::Vector3d::Zero(), J_ref = Eigen::Vector3d::Zero();
@@ -198,6 +213,7 @@ RunSummary run_dynamic(Problem& problem, const RunOptions& o) {
   } catch (const std::exception& e) {
     sum.status = std::string("incomplete: ") + e.what();
     sum.wall_seconds = std::chrono::duration<double>(Clock::now() - start).count();
+    sum.cpu_seconds = cpu_now(thread_cpu) - cpu0;
     if (files) {
       info.status = sum.status;
       fill_summary_json(info.summary, sum);
@@ -207,6 +223,7 @@ RunSummary run_dynamic(Problem& problem, const RunOptions& o) {
   }
   sum.status = "complete";
   sum.wall_seconds = std::chrono::duration<double>(Clock::now() - start).count();
+  sum.cpu_seconds = cpu_now(thread_cpu) - cpu0;
   if (files) {
     info.status = sum.status;
     fill_summary_json(info.summary, sum);
@@ -239,6 +256,7 @@ void print_run_summary(std::ostream& out, const RunSummary& s) {
   line("max |J - J_ref| after loads", num(s.max_dJ) + " (|J_ref| = " + num(s.ref_J) + ")");
   for (const auto& [name, value] : s.final_monitors) line("final " + name, num(value));
   line("wall time [s]", num(s.wall_seconds));
+  line("CPU time [s]", num(s.cpu_seconds));
 }
 
 }  // namespace shelldyn
