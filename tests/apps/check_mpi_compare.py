@@ -12,8 +12,9 @@ same: a flying-plate sweep of 5 runs (one fails by design) once in one process (
       must show runs on at least two ranks.
 kill: `mpirun -n 3` on a sweep of two long and two short runs; when the short ones have finished, a rank
       other than 0 running a long run is killed (SIGKILL). The summary must still list every run: the
-      short ones complete, the long ones "failed: job terminated ... while running on rank R". A rerun
-      with --resume must reuse exactly the finished runs (log says "reused") and complete the others.
+      short ones complete, the killed rank's run "failed: job terminated ... while running on rank R", the
+      other long run the same on its rank, or complete if it finished within the launcher's grace period.
+      A rerun with --resume must reuse exactly the complete runs (log says "reused") and run the others.
 skip: print MESSAGE and exit 77 (ctest SKIP_RETURN_CODE) — MPI not built or no launcher.
 Every subprocess has a timeout, so a hung MPI job fails the test instead of hanging CI.
 """
@@ -26,8 +27,11 @@ import sys
 import time
 
 SKIP = 77
+# odls_base_sigkill_timeout: Open MPI's grace between SIGTERM and SIGKILL when it terminates a job (default
+# 1 s) is raised to 10 s, as docs/cluster-sweeps.md recommends: on this shared test machine rank 0 may need
+# more than 1 s of wall time to write the final summary.
 ENV = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1", OPENBLAS_NUM_THREADS="1",
-           OMPI_MCA_rmaps_base_oversubscribe="1")
+           OMPI_MCA_rmaps_base_oversubscribe="1", OMPI_MCA_odls_base_sigkill_timeout="10")
 
 
 def fail(msg):
@@ -131,6 +135,7 @@ def kill(exe, mpiexec, out):
     if complete != {"galpha_dt=0.1", "em-galpha_rho_inf=0.9_dt=0.1"}:
         p.kill()
         fail(f"expected the two short runs to finish first, got {sorted(complete)}:\n" + "".join(seen))
+    time.sleep(1.0)  # let rank 0 finish writing the summary of the second short run
     victim = [on_rank[l] for l in long_runs if on_rank.get(l, 0) != 0]
     if not victim:
         p.kill()
@@ -156,16 +161,20 @@ def kill(exe, mpiexec, out):
         fail(f"summary.csv after the kill lists {sorted(r)}: every run must be a row")
     killed = [l for l in long_runs if on_rank.get(l) == rank]
     for l in long_runs:
+        # the killed rank's run must be reported failed; the other long run may have finished in the
+        # launcher's grace period, else it is reported failed on its rank too
         want = f"while running on rank {on_rank.get(l)}"
-        if not (r[l].startswith("failed: job terminated") and want in r[l]):
+        ok = r[l].startswith("failed: job terminated") and want in r[l]
+        if not ok and not (l not in killed and r[l] == "complete"):
             fail(f"{l}: status {r[l]!r}, expected 'failed: job terminated ... {want}'")
     for l in ("galpha_dt=0.1", "em-galpha_rho_inf=0.9_dt=0.1"):
         if r[l] != "complete":
             fail(f"{l}: status {r[l]!r}")
+    done_before = {l for l, st in r.items() if st == "complete"}
     log = run([mpiexec, "-n", "2", "--oversubscribe"] + sweep[:-2] + ["--resume", "-o", d], 600)
     reused = set(re.findall(r"\] (\S+): .*\(reused", log))
-    if reused != {"galpha_dt=0.1", "em-galpha_rho_inf=0.9_dt=0.1"}:
-        fail(f"--resume reused {sorted(reused)}, expected the two runs finished before the kill")
+    if reused != done_before:
+        fail(f"--resume reused {sorted(reused)}, expected the runs complete after the kill {sorted(done_before)}")
     if any(x["status"] != "complete" for x in rows(d)):
         fail("after --resume: " + str([x["status"] for x in rows(d)]))
     print(f"OK: rank {rank} killed while running {killed}; every run reported; --resume reused {sorted(reused)} and "
