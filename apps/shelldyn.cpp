@@ -395,8 +395,13 @@ int run_study_command(const StudyCommandOptions& o) {
   so.log = &std::cout;
   so.command = o.command;
   if (!o.dry_run) app::check_output_folder(so.out_dir);
+  // Where the runs execute: as `shelldyn compare` (the ranks of mpirun/srun, else --jobs threads).
+  const std::unique_ptr<RunExecutor> executor = app::make_sweep_executor(o.jobs, 0);
+  so.execution.executor = executor.get();
+  so.report = executor->collects();
+  if (!so.report) so.log = nullptr;
   const StudyResult r = run_study(so);
-  if (o.dry_run) return 0;
+  if (o.dry_run || !so.report) return 0;
   std::cout << "study " << o.benchmark << ": " << r.ran << " runs made, " << r.skipped << " already complete, " << r.failed
             << " failed; wrote " << r.study_csv << ", " << r.study_md << std::endl;
   if (!o.no_plots && app::run_python_script(app::find_script("plot_study.py"), {so.out_dir}, std::cout))

@@ -238,7 +238,7 @@ StudyResult run_study(const StudyOptions& o) {
     co.t_end = group == "window" ? p.window_t_end : -1.0;
     co.output_interval = group == "window" ? p.window_output : p.full_output;
     co.out_dir = (fs::path(o.out_dir) / group).string();
-    co.log = o.log;
+    co.log = o.report ? o.log : nullptr;
     co.command = o.command;
     for (const auto& r : runs) co.specs.push_back(r.spec);
     const std::vector<CompareRun> expanded = expand_compare_runs(co);  // labels; bad specs fail here
@@ -262,6 +262,8 @@ StudyResult run_study(const StudyOptions& o) {
     const CompareResult cr = run_comparison(co);
     result.ran += static_cast<int>(cr.rows.size());
   }
+
+  if (!o.report) return result;  // an MPI worker rank: rank 0 reports
 
   // --- rows from the run folders (resumed runs included) -------------------------------------------------
   std::map<std::string, CsvTable> ref_table;  // group -> reference history

@@ -65,7 +65,9 @@ struct StudyOptions {
   std::vector<std::string> groups = {"window", "full"};
   bool rerun = false;                     // true: run completed runs again
   bool dry_run = false;                   // true: list the runs (and which are done), run nothing
-  CompareOptions execution;               // jobs / threads / execution settings handed to run_comparison()
+  CompareOptions execution;               // jobs / threads / executor handed to run_comparison() (MPI: every rank
+                                          // calls run_study; only the one with report = true writes the tables)
+  bool report = true;
   std::ostream* log = nullptr;
   std::string command;
 };
