@@ -57,7 +57,7 @@ class FirstOrderSystem {
   //                       where every q entry counts as a translation)
   //   director unknowns:  1 (components of a unit vector)
   //   velocities ḋ:       L/τ,  director rates: 1/τ   (τ: time scale, see the baselines' time_scale setting)
-  //   external work w:    max(K₀ + |V₀|, m (L/τ)²)     (m: total mass, eᵀ M e for rigid unit translations e)
+  //   external work w:    max(1, K₀ + |V₀|)
   struct ToleranceScales {
     double length = 1.0, time = 1.0, velocity = 1.0, energy = 1.0;
     bool shell = false;  // a shell Model: 5 DOFs per node, [d_X, d_Y, d_Z, q_1, q_2]

@@ -11,14 +11,14 @@
 // evaluations) goes to the progress log, so that long output intervals are not silent.
 //
 // Tolerances (docs/results.md, "Baseline tuning"): rtol, and absolute tolerances per component
-//     atol_k = atol · scale_k,   atol = 0 (default) meaning atol = rtol / 100,
+//     atol_k = atol · scale_k,   atol = 0 (default) meaning atol = rtol / 1000,
 // with the scales of FirstOrderSystem::tolerance_scales (translations L, director unknowns 1, velocities L/τ,
-// director rates 1/τ, external work m (L/τ)²). L = length_scale [0: the mesh's bounding-box diagonal],
-// τ = time_scale [0: the time the loads end, or 1 if there are none]. The resolved values are reported in
+// director rates 1/τ, external work max(1, K₀ + |V₀|)). L = length_scale [0: the mesh's bounding-box diagonal],
+// τ = time_scale [0: 1 s]. The resolved values are reported in
 // the settings (run.json) after initialize(): atol_translation, atol_director, atol_velocity,
 // atol_director_rate, atol_work, length_scale, time_scale.
 //
-// Common settings: rtol [1e-6], atol [0 = rtol/100], length_scale [0 = auto], time_scale [0 = auto],
+// Common settings: rtol [1e-6], atol [0 = rtol/1000], length_scale [0 = auto], time_scale [0 = auto],
 // max_step [0 = none], init_step [0 = solver's choice], max_steps [1e8], chart_overshoot [0.05],
 // mass_solver [eigen-ldlt], mass_reuse [true] (FirstOrderSystem), progress_every [10 s wall; 0 = off].
 #pragma once
