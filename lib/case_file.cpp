@@ -73,7 +73,7 @@ class Parser {
       const std::string key = it->first.Scalar();
       const std::string sub = path.empty() ? key : path + "." + key;
       if (std::find(allowed.begin(), allowed.end(), key) == allowed.end())
-        fail(it->first, sub, "unknown key '" + key + "' (allowed here: " + join(allowed) + ")");
+        fail(it->first, sub, "unknown key '" + key + "' (check the spelling; allowed keys below)\nallowed here: " + join(allowed));
       if (!seen.insert(key).second) fail(it->first, sub, "duplicate key '" + key + "' (keep only one)");
     }
     for (const auto& key : required)
@@ -142,7 +142,7 @@ class Parser {
     const std::string s = string(n, path);
     for (size_t k = 0; k < choices.size(); ++k)
       if (s == choices[k]) return k;
-    fail(n, path, "unknown value '" + s + "' (expected one of: " + join(choices) + ")");
+    fail(n, path, "unknown value '" + s + "' (valid values below)\nexpected one of: " + join(choices));
   }
 
   void require_sequence(const YAML::Node& n, const std::string& path, const char* what) const {
@@ -327,7 +327,7 @@ std::vector<BoundaryConditionSpec> parse_bcs(const Parser& p, const YAML::Node& 
       try {
         bc.fix.push_back(parse_fix(s));
       } catch (const std::invalid_argument&) {
-        p.fail(fix[j], fp, "unknown DOF name '" + s + "' (expected one of: ux, uy, uz, px, py, pz, director)");
+        p.fail(fix[j], fp, "unknown DOF name '" + s + "' (valid names below)\nexpected one of: ux, uy, uz, px, py, pz, director");
       }
     }
     bcs.push_back(std::move(bc));
@@ -422,6 +422,7 @@ IntegratorSpec parse_integrator(const Parser& p, const YAML::Node& n) {
   if (!n["name"]) p.fail(n, "integrator.name", "missing required key 'name' (e.g. name: em-galpha)");
   IntegratorSpec s;
   s.name = p.name(n["name"], "integrator.name");
+  s.where = p.where(n["name"], "");
   std::set<std::string> seen;
   for (auto it = n.begin(); it != n.end(); ++it) {
     const std::string key = p.string(it->first, "integrator");
@@ -431,6 +432,7 @@ IntegratorSpec parse_integrator(const Parser& p, const YAML::Node& n) {
     if (!it->second.IsScalar())
       p.fail(it->second, path, "integrator settings must be single values, got a " + node_kind(it->second));
     s.settings.emplace_back(key, it->second.Scalar());
+    s.setting_where.push_back(p.where(it->first, ""));
   }
   return s;
 }
@@ -441,6 +443,9 @@ TimeSpec parse_time(const Parser& p, const YAML::Node& n) {
   t.dt = p.positive(n["dt"], "time.dt");
   t.t_end = p.positive(n["t_end"], "time.t_end");
   if (t.dt > t.t_end) p.fail(n["dt"], "time.dt", "dt must not exceed t_end");
+  // A step count that no run can reach (and that would overflow the step counters) is a typo.
+  if (t.t_end / t.dt > 1e10)
+    p.fail(n["t_end"], "time.t_end", "t_end/dt is more than 1e10 steps; check t_end and dt");
   t.output_interval = t.dt;
   if (n["output_interval"]) {
     t.output_interval = p.positive(n["output_interval"], "time.output_interval");

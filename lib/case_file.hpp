@@ -131,6 +131,10 @@ struct LoadSpec {
 struct IntegratorSpec {
   std::string name;
   std::vector<std::pair<std::string, std::string>> settings;  // in file order, values as written
+  // "FILE:LINE" of the block and of each setting (parallel to `settings`), for errors that the
+  // integrator raises later (integrators/runs/case_integrator.hpp); empty for specs not read from a file.
+  std::string where;
+  std::vector<std::string> setting_where;
 };
 
 struct TimeSpec {

@@ -40,8 +40,8 @@ std::string available_sets(const Mesh& mesh) {
 const std::vector<int>& find_set(const Mesh& mesh, const std::string& name, const std::string& where) {
   auto it = mesh.node_sets.find(name);
   if (it == mesh.node_sets.end())
-    fail(where, "unknown set '" + name + "' (available: " + available_sets(mesh) +
-                    "; define it under 'sets:')");
+    fail(where, "unknown set '" + name + "' (define it under 'sets:' or use one below)\navailable: " +
+                    available_sets(mesh));
   return it->second;
 }
 
@@ -70,11 +70,10 @@ void resolve_case_sets(const CaseSpec& spec, Mesh& mesh, double mesh_size) {
         }
         if (best < 0 || best_d > tol) {
           std::ostringstream os;
-          os << "no node within tol = " << tol << " of the point " << fmt(s.point);
+          os << "no node within tol = " << tol << " of the point " << fmt(s.point) << " (correct the point or set 'tol')";
           if (best >= 0)
-            os << "; the nearest is node " << best << " at " << fmt(mesh.X[static_cast<size_t>(best)])
+            os << "\nthe nearest is node " << best << " at " << fmt(mesh.X[static_cast<size_t>(best)])
                << ", distance " << best_d;
-          os << " (correct the point or set 'tol')";
           fail(s.where + ".point", os.str());
         }
         nodes.push_back(best);

@@ -83,10 +83,10 @@ std::vector<StaticRow> run_static(Problem& problem, const std::string& out_dir, 
   };
 
   State state = model.initial_state();
-  record(state, 0, 0);
-  StaticSolver solver(model, options);
   StaticReport report;
-  try {
+  try {  // bad settings and I/O errors too must end in "incomplete: <reason>", not "running"
+    record(state, 0, 0);
+    StaticSolver solver(model, options);
     report = solver.solve(state, spec.time.t_end, [&](const State& s, const StaticIncrement& inc) {
       record(s, inc.step, inc.newton_iterations);
       if (log) {
@@ -101,7 +101,11 @@ std::vector<StaticRow> run_static(Problem& problem, const std::string& out_dir, 
   } catch (const std::exception& e) {
     if (!out_dir.empty()) {
       info.status = std::string("incomplete: ") + e.what();
-      write_run_json(out_dir + "/run.json", spec, info);
+      try {
+        write_run_json(out_dir + "/run.json", spec, info);
+      } catch (const std::exception& j) {  // e.g. the disk is full: report the cause, then this
+        throw std::runtime_error(std::string(e.what()) + "; " + j.what());
+      }
     }
     throw;
   }
