@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
 # Installs shelldyn's build and test dependencies from Debian 12's packages (run as root).
 # Idempotent: does nothing (not even `apt-get update`) when every package is already installed.
+#   bash scripts/install-deps.sh              # what the default build and tests need
+#   bash scripts/install-deps.sh --with-mpi   # also Open MPI: MPI-distributed sweeps (docs/cluster-sweeps.md)
 set -euo pipefail
 
 PACKAGES=(
@@ -11,6 +13,7 @@ PACKAGES=(
   libeigen3-dev                        # Eigen 3.4
   libyaml-cpp-dev libcli11-dev         # case files, command line
   nlohmann-json3-dev                   # run.json and checkpoints (lib/run_info, integrators/checkpoint)
+  libspectra-dev                       # Spectra: shift-invert Lanczos of `shelldyn modes` (header-only)
   libgtest-dev libgmock-dev            # unit tests
   libbenchmark-dev                     # performance programs
   python3 python3-meshio               # VTU round-trip check in the test suite
@@ -18,6 +21,10 @@ PACKAGES=(
 )
 # Not listed (opt-in tools): clang-14 libclang-rt-14-dev for scripts/fuzz.sh (libFuzzer); .ci/run
 # installs them itself when SHELLDYN_CI_SANITIZE=1.
+
+if [ "${1:-}" = "--with-mpi" ]; then
+  PACKAGES+=(libopenmpi-dev openmpi-bin)   # optional: SHELLDYN_WITH_MPI, `mpirun -n P shelldyn compare`
+fi
 
 missing=()
 for p in "${PACKAGES[@]}"; do

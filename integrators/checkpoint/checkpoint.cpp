@@ -101,6 +101,7 @@ void write_checkpoint(const std::string& path, const Checkpoint& c) {
   s["u"] = bytes_of(c.state.u);
   s["v"] = bytes_of(c.state.v);
   s["a"] = bytes_of(c.state.a);
+  s["pdot"] = bytes_of(c.state.pdot);  // empty unless the integrator embeds director velocities
   std::vector<int> charts;
   charts.reserve(4 * c.state.charts.size());
   for (const auto& ch : c.state.charts) {
@@ -141,6 +142,7 @@ Checkpoint read_checkpoint(const std::string& path) {
     c.state.u = vector_of(s.at("u"), "u");
     c.state.v = vector_of(s.at("v"), "v");
     c.state.a = vector_of(s.at("a"), "a");
+    c.state.pdot = vector_of(s.at("pdot"), "pdot");
     const auto charts = s.at("charts").get<std::vector<int>>();
     if (charts.size() % 4 != 0) throw std::runtime_error("state.charts is truncated");
     for (size_t k = 0; k < charts.size(); k += 4) {
