@@ -166,17 +166,17 @@ void prepare_result_folder(const std::string& dir, bool overwrite) {
 namespace {
 [[noreturn]] void bad_number(const std::string& flag, double value, const std::string& what, const std::string& example) {
   std::ostringstream os;
-  os << flag << " " << value << ": " << what << ", e.g. " << example;
+  os << flag << " must be " << what << " (got " << value << "), e.g. " << example;
   throw std::invalid_argument(os.str());
 }
 }  // namespace
 
 void check_positive(const std::string& flag, double value, const std::string& example) {
-  if (!std::isfinite(value) || !(value > 0.0) || value > 1e15) bad_number(flag, value, "must be a number in (0, 1e15]", example);
+  if (!std::isfinite(value) || !(value > 0.0) || value > 1e15) bad_number(flag, value, "> 0 and at most 1e15", example);
 }
 
 void check_non_negative(const std::string& flag, double value, const std::string& example) {
-  if (!std::isfinite(value) || !(value >= 0.0) || value > 1e15) bad_number(flag, value, "must be a number in [0, 1e15]", example);
+  if (!std::isfinite(value) || !(value >= 0.0) || value > 1e15) bad_number(flag, value, ">= 0 and at most 1e15", example);
 }
 
 void check_range(const std::string& flag, long long value, long long lo, long long hi, const std::string& example) {

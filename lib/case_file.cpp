@@ -73,7 +73,7 @@ class Parser {
       const std::string key = it->first.Scalar();
       const std::string sub = path.empty() ? key : path + "." + key;
       if (std::find(allowed.begin(), allowed.end(), key) == allowed.end())
-        fail(it->first, sub, "unknown key '" + key + "' (check the spelling; allowed keys below)\nallowed here: " + join(allowed));
+        fail(it->first, sub, "unknown key '" + key + "' (allowed here: " + join(allowed) + ")");
       if (!seen.insert(key).second) fail(it->first, sub, "duplicate key '" + key + "' (keep only one)");
     }
     for (const auto& key : required)
@@ -142,7 +142,7 @@ class Parser {
     const std::string s = string(n, path);
     for (size_t k = 0; k < choices.size(); ++k)
       if (s == choices[k]) return k;
-    fail(n, path, "unknown value '" + s + "' (valid values below)\nexpected one of: " + join(choices));
+    fail(n, path, "unknown value '" + s + "' (expected one of: " + join(choices) + ")");
   }
 
   void require_sequence(const YAML::Node& n, const std::string& path, const char* what) const {
@@ -327,7 +327,7 @@ std::vector<BoundaryConditionSpec> parse_bcs(const Parser& p, const YAML::Node& 
       try {
         bc.fix.push_back(parse_fix(s));
       } catch (const std::invalid_argument&) {
-        p.fail(fix[j], fp, "unknown DOF name '" + s + "' (valid names below)\nexpected one of: ux, uy, uz, px, py, pz, director");
+        p.fail(fix[j], fp, "unknown DOF name '" + s + "' (expected one of: ux, uy, uz, px, py, pz, director)");
       }
     }
     bcs.push_back(std::move(bc));

@@ -196,7 +196,7 @@ Mesh read_gmsh(std::istream& in, const std::string& path) {
       lex.next_int("the data size");
       if (version != "4.1")
         lex.fail("MSH version " + version +
-                 " is not supported: export MSH 4.1 ASCII (gmsh -format msh41, or Mesh.MshFileVersion = 4.1)");
+                 " is not supported: export MSH 4.1 ASCII (gmsh -format msh41)");
       if (file_type != 0)
         lex.fail("binary MSH files are not supported; save as ASCII (Mesh.Binary = 0, no '-bin')");
       lex.expect("$EndMeshFormat");
