@@ -290,7 +290,7 @@ Mesh read_gmsh(std::istream& in, const std::string& path) {
         const int npe = nodes_per_element(blk.type);
         if (npe == 0)
           lex.fail("element type " + std::to_string(blk.type) + " (" + type_name(blk.type) +
-                   ") is not supported: use 9-node quads (type 10; how below)\n"
+                   ") is not supported: only 9-node quadrangles (type 10) are\n"
                    "gmsh -2 -order 2 with Mesh.RecombineAll = 1 and Mesh.SecondOrderIncomplete = 0");
         if (blk.type == 10 && blk.dim != 2)
           lex.fail("quad9 elements (type 10) must belong to a surface (entity dimension 2), found " +
