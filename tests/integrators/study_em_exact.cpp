@@ -48,6 +48,7 @@ Long long_run(Model& model, State s, const std::string& name, double dt, double 
     if (k % (n / 20) == 0)
       std::printf("  %s %s dt %g  t = %6.1f  dH/H %+.2e  max|dH|/H %.2e  strain/H %.2e  max|dJ|/|J| %.2e\n", label,
                   name.c_str(), dt, k * dt, r.final_dH, r.max_dH, inv.strain / H, r.max_dJ);
+    if (k % (n / 20) == 0) std::fflush(stdout);
   }
   std::printf("%s %-9s dt %-5g: max|dH|/H %.2e  max|dL|/|L| %.2e  max|dJ|/|J| %.2e  max strain/H %.2e  %.2f it/step  %ld switches\n",
               label, name.c_str(), dt, r.max_dH, r.max_dL, r.max_dJ, r.max_strain, double(r.iterations) / r.steps,
@@ -87,9 +88,13 @@ TEST(EmExactStudy, DISABLED_TumblingPlate200sDt002) {
   const Long r = spin({0.01, 1.0, 0.01}, 0.02, "tumbling 200 s");
   EXPECT_LT(r.max_strain, 1e-6);
 }
-TEST(EmExactStudy, DISABLED_SpinR1R2200s) {
-  spin({0, 0, 1}, 0.01, "R1 200 s");
-  spin({1, 0, 0}, 0.01, "R2 200 s");
+TEST(EmExactStudy, DISABLED_SpinR1200s) {
+  const Long r = spin({0, 0, 1}, 0.01, "R1 200 s");
+  EXPECT_LT(r.max_strain, 1e-6);
+}
+TEST(EmExactStudy, DISABLED_SpinR2200s) {
+  const Long r = spin({1, 0, 0}, 0.01, "R2 200 s");
+  EXPECT_LT(r.max_strain, 1e-6);
 }
 
 }  // namespace
