@@ -1,4 +1,4 @@
-// CR9 shell element: spec/element.md §2.4 (set-up), §3.4 (global force/tangent), §4 (local strains,
+// CR9 shell element: docs/theory.md §2.4 (set-up), §3.4 (global force/tangent), §4 (local strains,
 // MITC9, resultants), §5 (inertia), §6.3 (strain-averaged algorithmic force).
 #include "elements/cr9_shell.hpp"
 

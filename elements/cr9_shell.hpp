@@ -1,5 +1,5 @@
 // CR9: co-rotational 9-node shell element with vectorial rotational variables
-// (spec/element.md §§1-6.3; Li & Qian 2025, Li, Izzuddin & Vu-Quoc 2008), MITC9 assumed strains.
+// (docs/theory.md §§1-6.3; Li & Qian 2025, Li, Izzuddin & Vu-Quoc 2008), MITC9 assumed strains.
 //
 // Node numbering (spec §1, Gmsh type 10; 0-based index in code = node - 1):
 //

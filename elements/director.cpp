@@ -1,4 +1,4 @@
-// Director parametrisation by minor components: spec/element.md §2.1-2.3.
+// Director parametrisation by minor components: docs/theory.md §2.1-2.3.
 #include "elements/director.hpp"
 
 #include <cmath>

@@ -130,7 +130,7 @@ void resolve_case_sets(const CaseSpec& spec, Mesh& mesh, double mesh_size) {
 }
 
 // Consistent nodal weights of a uniform line load on the quadratic edges that lie entirely in
-// `nodes` (element.md §4.1 shape functions restricted to an edge): w_k = ∫ N_k |dX/ds| ds, normalised
+// `nodes` (docs/theory.md §4.1 shape functions restricted to an edge): w_k = ∫ N_k |dX/ds| ds, normalised
 // to sum 1. A straight edge with a centred mid-node gets 1/6, 4/6, 1/6 of its length share.
 std::map<int, double> edge_weights(const Mesh& mesh, const std::vector<int>& nodes, const std::string& where) {
   static const int kEdges[4][3] = {{0, 4, 1}, {1, 5, 2}, {2, 6, 3}, {3, 7, 0}};  // corner, mid, corner
@@ -214,7 +214,7 @@ Discretization build_discretization(const CaseSpec& spec) {
 
   resolve_case_sets(spec, mesh, d.mesh_size);
 
-  // Boundary conditions (element.md §2.3 item 2): recorded by meaning, resolved for the initial charts.
+  // Boundary conditions (docs/theory.md §2.3 item 2): recorded by meaning, resolved for the initial charts.
   d.dofs = DofMap(n);
   for (const auto& bc : spec.boundary_conditions)
     for (int node : find_set(mesh, bc.set, bc.where + ".set"))
@@ -235,7 +235,7 @@ Discretization build_discretization(const CaseSpec& spec) {
     fail(spec.boundary_conditions.empty() ? spec.source : spec.boundary_conditions.front().where, e.what());
   }
 
-  // Initial velocity: rigid-body field v = v0 + ω × (X − about), ṗ = ω × p (benchmarks.md §6).
+  // Initial velocity: rigid-body field v = v0 + ω × (X − about), ṗ = ω × p (docs/benchmarks.md §6).
   d.initial_velocity = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(n) * kDofsPerNode);
   const InitialVelocitySpec& iv = spec.initial_velocity;
   if (iv.given) {

@@ -39,8 +39,8 @@ struct Discretization {
   // The mesh, consistently oriented (orient_consistently), with the case's sets added to
   // mesh.node_sets next to the generator's / Gmsh's own sets.
   Mesh mesh;
-  std::vector<Vec3> normals;          // initial unit nodal normals p_i0 (element.md §2.4)
-  std::vector<DirectorChart> charts;  // select_chart(p_i0) per node (element.md §2.3)
+  std::vector<Vec3> normals;          // initial unit nodal normals p_i0 (docs/theory.md §2.4)
+  std::vector<DirectorChart> charts;  // select_chart(p_i0) per node (docs/theory.md §2.3)
   DofMap dofs{0};                     // boundary conditions recorded and resolved for `charts`
   // 5 per node: [v_X, v_Y, v_Z, q̇_1, q̇_2] with v = translation + ω × (X − about), q̇ = S (ω × p_i0)
   // (S = 2x3 selector of the chart's minor components n, m). Zero if the case has no initial velocity.

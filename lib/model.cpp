@@ -196,7 +196,7 @@ void Model::external(double t, const Eigen::VectorXd& u, const std::vector<Direc
     if (load.kind == NodalLoad::Kind::Force) {
       for (int c = 0; c < 3; ++c) F[DofMap::dof(load.node, c)] += f * load.vector[c];
     } else {
-      // Dead moment m: δW = m·δφ with δp = δφ × p, so f_q = A1ᵀ (m × p) (spec/element.md §2.3 item 3).
+      // Dead moment m: δW = m·δφ with δp = δφ × p, so f_q = A1ᵀ (m × p) (docs/theory.md §2.3 item 3).
       const Eigen::Vector2d q = u.segment<2>(DofMap::dof(load.node, 3));
       const DirectorChart& ch = charts[static_cast<size_t>(load.node)];
       const Eigen::Vector2d fq = director_A1(q, ch).transpose() * (f * load.vector).cross(shelldyn::director(q, ch));

@@ -1,4 +1,4 @@
-// The semi-discretization M(q) q̈ + F_m(q, q̇) + F_int(q) = F_ext(t)   (paper eq. 26; spec/element.md §5.3)
+// The semi-discretization M(q) q̈ + F_m(q, q̇) + F_int(q) = F_ext(t)   (paper eq. 26; docs/theory.md §5.3)
 // of a mesh of CR9 shell elements (architecture.md §4.2).
 //
 // The Model knows nothing about time integration: it evaluates forces, matrices, energies and momenta
@@ -26,7 +26,7 @@
 namespace shelldyn {
 
 // A load on one node: a dead force (global vector) or a dead moment m, whose generalised force on the
-// director unknowns is A1ᵀ (m × p) (spec/element.md §2.3 item 3), both scaled by f(t).
+// director unknowns is A1ᵀ (m × p) (docs/theory.md §2.3 item 3), both scaled by f(t).
 struct NodalLoad {
   enum class Kind { Force, Moment };
   int node = 0;
@@ -59,7 +59,7 @@ class Model final : public SemiDiscreteSystem {
   // F_int(q), K = ∂F_int/∂q (exact, symmetric), returns V = Σ U_e. F or K may be null.
   double internal(const Eigen::VectorXd& u, const std::vector<DirectorChart>& charts, double* F,
                   SparseMatrix* K) const override;
-  // Strain-averaged force F*_int,mid and its symmetric tangent K_mid (spec/element.md §6.3); returns V(u_np1).
+  // Strain-averaged force F*_int,mid and its symmetric tangent K_mid (docs/theory.md §6.3); returns V(u_np1).
   double algorithmic_internal(const Eigen::VectorXd& u_n, const Eigen::VectorXd& u_np1,
                               const std::vector<DirectorChart>& charts, double alpha_f, double xi, double* F,
                               SparseMatrix* K) const override;
@@ -83,7 +83,7 @@ class Model final : public SemiDiscreteSystem {
   // Current director of node i.
   Vec3 director(const State& s, int node) const;
 
-  // Re-selects director charts between increments (spec/element.md §2.3), converting u, v, a, and
+  // Re-selects director charts between increments (docs/theory.md §2.3), converting u, v, a, and
   // re-resolves director constraints. Returns the number of nodes whose chart switched.
   int rechart(State& s, double hysteresis = 1.0) override;
   double chart_margin(const State& s) const override;

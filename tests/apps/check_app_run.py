@@ -11,7 +11,7 @@ Runs COMMAND (the app, writing into RESULT_DIR; must exit 0 within 300 s), then 
   NaN before the loads end), K >= 0;
 - --impulse: after the loads end, L equals the load impulse (computed from the case's load functions by
   the caller) to 1e-9 relative, and stays constant to 1e-10 relative (linear momentum is conserved to
-  round-off by every integrator; spec/element.md §6.7);
+  round-off by every integrator; docs/theory.md §6.7);
 - --max-energy-error: max |H - H_ref| / (K_ref + V_ref) after the loads end is below E;
 - --zero-momentum: |L| and |J| stay below 1e-9 * SCALE (self-equilibrated loads);
 - PNG plots exist when matplotlib is importable;

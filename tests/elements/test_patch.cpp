@@ -1,4 +1,4 @@
-// spec/element.md §7.8: linear membrane and bending patch tests (K_0 u = 0 with boundary nodes prescribed
+// docs/theory.md §7.8: linear membrane and bending patch tests (K_0 u = 0 with boundary nodes prescribed
 // by the exact field) on a skewed parallelogram mesh and on the MacNeal-Harder 5-element trapezoidal
 // patch; h = 0.001, E = 1e6, nu = 0.25. MITC9 passes exactly on parallelograms; on trapezoids its
 // membrane error is ~1 % (§4.4 known property), and the plain displacement element is exact.

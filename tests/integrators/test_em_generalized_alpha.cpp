@@ -1,5 +1,5 @@
-// The energy–momentum generalized-α scheme and its classical relatives (spec/element.md §6, §7 items
-// 12–14; spec/benchmarks.md §6): spectral radii on a linear oscillator, conservation in free flight,
+// The energy–momentum generalized-α scheme and its classical relatives (docs/theory.md §6, §7 items
+// 12–14; docs/benchmarks.md §6): spectral radii on a linear oscillator, conservation in free flight,
 // dissipation, director-chart switching, rigid spins, the discrete energy balance under load, and what the
 // strain averaging buys on a stiff free-flying plate.
 #include "integrators/newmark/em_generalized_alpha.hpp"
@@ -54,7 +54,7 @@ std::vector<double> root_moduli(double rho_inf, double xi, double Omega) {
   return m;
 }
 
-// spec/element.md §6.7 table (spectral radius of the principal roots) and §7 item 13.
+// docs/theory.md §6.7 table (spectral radius of the principal roots) and §7 item 13.
 TEST(EmGeneralizedAlpha, SpectralRadiiReproduceTheTable) {
   struct Row {
     double rho, xi;
@@ -92,7 +92,7 @@ struct FlightResult {
   double max_jump_at_switch = 0, max_jump_elsewhere = 0;
 };
 
-// Free flight of spec/element.md §7 item 12 (two 1×1 elements, h 0.1, ν 0.3, ρ 1).
+// Free flight of docs/theory.md §7 item 12 (two 1×1 elements, h 0.1, ν 0.3, ρ 1).
 FlightResult fly(const std::string& name, double E, double dt, int steps, Eigen::Vector3d v0, Eigen::Vector3d w,
                  double beta, std::vector<std::pair<std::string, std::string>> settings = {}) {
   auto model = free_plate(2.0, 1.0, 2, 1, ShellMaterial{E, 0.3, 1.0, 0.1});
@@ -176,7 +176,7 @@ TEST(EmGeneralizedAlpha, DirectorSwitchingCausesNoEnergyJump) {
   EXPECT_LT(r.max_dL, 1e-12);
 }
 
-// spec/benchmarks.md §6: plate 2 × 1, h 0.1, ρ 1, E 1e8, 4×2 mesh, spin about a principal axis.
+// docs/benchmarks.md §6: plate 2 × 1, h 0.1, ρ 1, E 1e8, 4×2 mesh, spin about a principal axis.
 TEST(EmGeneralizedAlpha, RigidSpinsKeepExactEnergyAndAngularMomentum) {
   struct Spin {
     Eigen::Vector3d w;
@@ -209,7 +209,7 @@ TEST(EmGeneralizedAlpha, RigidSpinsKeepExactEnergyAndAngularMomentum) {
     // 3.1e-7 over two (1.25e-6 at Δt = 0.02); R1 keeps p fixed and is exact to round-off.
     EXPECT_LT(max_dK, 5e-7);
     EXPECT_LT(max_dJ, 3e-7);
-    EXPECT_LT(max_V, 1e-6);  // benchmarks.md §6: no spurious strain energy
+    EXPECT_LT(max_V, 1e-6);  // docs/benchmarks.md §6: no spurious strain energy
     // R2 turns every director through 360°: 4 chart switches per node per turn (45 nodes).
     if (spin.w.x() == 1) {
       EXPECT_EQ(switches, 4 * 45);
