@@ -16,7 +16,7 @@ double dependent_component(const Eigen::Vector2d& q, const DirectorChart& ch) {
     std::ostringstream os;
     os << "director: minor components q = (" << q(0) << ", " << q(1) << ") give 1 - |q|^2 = " << r
        << " <= 0 (dependent component " << "XYZ"[ch.l]
-       << " lost); the Newton iterate overshot -- reject the iteration and cut the step (spec §2.1)";
+       << " lost); the Newton iterate overshot -- reject the iteration and cut the step (docs/theory.md §2.1)";
     throw std::domain_error(os.str());
   }
   return ch.s * std::sqrt(r);

@@ -18,6 +18,7 @@
 #include "lib/semi_discrete_system.hpp"
 #include "lib/sparse_matrix.hpp"
 #include "lib/state.hpp"
+#include "lib/surface_loads.hpp"
 #include "lib/time_function.hpp"
 
 #include <Eigen/Core>
@@ -80,6 +81,18 @@ class Model final : public SemiDiscreteSystem {
   Invariants invariants(const State& s) const override;
   double loads_end() const override;
 
+  // Distributed loads and damping (lib/surface_loads.hpp, docs/theory.md §8). Follower pressures act in
+  // external() and add_load_stiffness() (their tangent in full, or its symmetric part for symmetric
+  // solvers); Rayleigh damping C = a_M M_0 + a_K K_0 (reference state, assembled once) adds C v to
+  // inertial() and inertia_force().
+  void set_follower_pressures(std::vector<FollowerPressure> loads) { follower_ = std::move(loads); }
+  const std::vector<FollowerPressure>& follower_pressures() const { return follower_; }
+  void set_unsymmetric_load_stiffness(bool full) { full_load_tangent_ = full; }
+  void set_rayleigh_damping(double mass_coefficient, double stiffness_coefficient);
+  bool has_damping() const override { return !damping_.values.empty(); }
+  void damping_force(const Eigen::VectorXd& v, double* out) const override;
+  void add_damping_matrix(double c, SparseMatrix& J) const override;
+
   // Current director of node i.
   Vec3 director(const State& s, int node) const;
 
@@ -91,6 +104,7 @@ class Model final : public SemiDiscreteSystem {
  private:
   void gather(int e, const Eigen::VectorXd& global, CR9Shell::Vec45& ue) const;
   CR9Shell::Charts element_charts(int e, const std::vector<DirectorChart>& charts) const;
+  void add_damping(const Eigen::VectorXd& v, double* out) const;  // out += C v
 
   Mesh mesh_;
   std::vector<Vec3> normals_;
@@ -99,6 +113,9 @@ class Model final : public SemiDiscreteSystem {
   std::vector<NodalLoad> loads_;
   Assembler assembler_;
   std::vector<CR9Shell> elements_;
+  std::vector<FollowerPressure> follower_;
+  bool full_load_tangent_ = false;
+  SparseMatrix damping_;  // empty values: no damping
 };
 
 }  // namespace shelldyn

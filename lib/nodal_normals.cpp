@@ -78,14 +78,14 @@ std::vector<Vec3> initial_normals(const Mesh& mesh) {
     for (int k = 0; k < 9; ++k) {
       Vec3 g1, g2;
       tangents(mesh, el, kXi[k], kEta[k], g1, g2);
-      const Vec3 n = g1.cross(g2);  // paper eq. 7 / spec §2.4 step 1
+      const Vec3 n = g1.cross(g2);  // paper eq. 7 / docs/theory.md §2.4 step 1
       const double len = n.norm();
       // Relative test: |g1 x g2| against |g1||g2| (scale-free degeneracy check).
       if (!(len > 1e-12 * g1.norm() * g2.norm()) || !std::isfinite(len))
         throw std::invalid_argument("initial_normals: " + where(e, k, el[k]) +
                                     ": X,xi x X,eta vanishes (degenerate or collapsed element); fix the "
                                     "mesh geometry");
-      sum[static_cast<size_t>(el[k])] += n / len;  // normalise first (spec §2.4 recommendation)
+      sum[static_cast<size_t>(el[k])] += n / len;  // normalise first (docs/theory.md §2.4 recommendation)
       ++count[static_cast<size_t>(el[k])];
     }
   }
@@ -100,7 +100,7 @@ std::vector<Vec3> initial_normals(const Mesh& mesh) {
                                   " cancel: adjacent elements are oriented oppositely (call "
                                   "orient_consistently() first) or the mesh is folded there (out of "
                                   "scope, docs/theory.md §2.4)");
-    sum[i] /= len;  // spec §2.4 step 2
+    sum[i] /= len;  // docs/theory.md §2.4 step 2
   }
   return sum;
 }

@@ -54,6 +54,12 @@ class SemiDiscreteSystem {
   // K += −sym ∂F_ext/∂q (configuration-dependent loads); default: dead loads, nothing to add.
   virtual void add_load_stiffness(double /*t*/, const Eigen::VectorXd& /*u*/,
                                   const std::vector<DirectorChart>& /*charts*/, SparseMatrix& /*K*/) const {}
+  // Rayleigh damping C = a_M M_0 + a_K K_0 (docs/theory.md §8.5). Systems with damping include C q̇ in
+  // inertial() and inertia_force(); integrators add c·C to iteration matrices (c = ∂q̇/∂q of their
+  // scheme) and accumulate the dissipated work with damping_force(). Default: no damping.
+  virtual bool has_damping() const { return false; }
+  virtual void damping_force(const Eigen::VectorXd& /*v*/, double* /*out*/) const {}       // out = C v
+  virtual void add_damping_matrix(double /*c*/, SparseMatrix& /*J*/) const {}              // J += c C
   virtual Invariants invariants(const State& s) const = 0;
   // Time after which F_ext vanishes identically (+inf if never; 0 if there are no loads).
   virtual double loads_end() const = 0;

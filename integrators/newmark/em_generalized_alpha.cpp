@@ -95,6 +95,7 @@ class NewmarkFamily final : public Integrator {
   std::string name() const override { return name_; }
   std::vector<std::pair<std::string, std::string>> settings() const override { return resolved_; }
   double external_work() const override { return work_; }
+  double damping_work() const override { return damping_work_; }
 
   void initialize(SemiDiscreteSystem& sys, State& s) override {
     const Index n = sys.num_dofs();
@@ -103,7 +104,7 @@ class NewmarkFamily final : public Integrator {
     K_ = M_;
     for (Eigen::VectorXd* v : {&un_, &vn_, &an_, &umid_, &vmid_, &amid_, &fint_, &fm_, &fext_, &fint_n_, &fext_n_, &tmp_})
       v->setZero(n);
-    work_ = 0.0;
+    work_ = damping_work_ = 0.0;
     sys.rechart(s, hysteresis_);
     // Consistent initial acceleration (docs/theory.md §6.4 start-up): M(u0) a0 = F_ext − F_int − F_m.
     sys.mass(s.u, s.charts, M_);
@@ -238,6 +239,7 @@ class NewmarkFamily final : public Integrator {
       }
       // §6.4: K̄ = (1−α_m)/(βΔt²) M_mid + (1−α_f) K_mid (symmetric; the (1−α_m) reading of §6.8 item 3).
       for (size_t k = 0; k < J.values.size(); ++k) J.values[k] = du * M_.values[k] + (1 - af) * K_.values[k];
+      sys.add_damping_matrix(cu, J);  // ∂(C u̇_mid)/∂u_{n+1} (docs/theory.md §8.5)
       apply_dirichlet(sys.dofs(), J, nullptr);
     };
 
@@ -259,6 +261,10 @@ class NewmarkFamily final : public Integrator {
     midpoint_state(u.data());
     external_force(u.data());
     work_ += fext_.dot(u - un_);
+    if (sys.has_damping()) {  // dissipated work Δuᵀ C u̇_mid (docs/theory.md §8.5)
+      sys.damping_force(vmid_, tmp_.data());
+      damping_work_ += tmp_.dot(u - un_);
+    }
     // §6.2 Newmark updates.
     s.a = (u - un_) / (be * h * h) - vn_ / (be * h) - (0.5 / be - 1.0) * an_;
     s.v = vn_ + h * ((1 - ga) * an_ + ga * s.a);
@@ -283,7 +289,7 @@ class NewmarkFamily final : public Integrator {
   std::unique_ptr<NewtonSolver> newton_, full_newton_;  // full_newton_: fallback of modified Newton
   SparseMatrix M_, K_;
   Eigen::VectorXd un_, vn_, an_, umid_, vmid_, amid_, fint_, fm_, fext_, fint_n_, fext_n_, tmp_, uscale_;
-  double work_ = 0.0;
+  double work_ = 0.0, damping_work_ = 0.0;
   double last_h_ = 0.0;
   long steps_ = 0;
 };

@@ -131,12 +131,12 @@ TEST(EmGeneralizedAlpha, FreeFlightConservesMomentumAndBoundsEnergy) {
   std::printf("free flight dt 0.02, 2 s: max|dH|/H %.3e, max|dJ|/|J| %.3e, max|dL|/|L| %.3e, %.2f iterations/step\n",
               r.max_dH, r.max_dJ, r.max_dL, double(r.iterations) / r.steps);
   EXPECT_LT(r.max_dL, 1e-12);  // linear momentum: exact up to round-off and solver tolerance (§6.7)
-  EXPECT_LT(r.max_dH, 2e-4);   // spec §7.12: ≈ 1e-4 (modes not resolved at this dt); measured 9.6e-5
-  EXPECT_LT(r.max_dJ, 1e-5);   // spec §7.12: ≈ 1e-5; measured 8e-8
+  EXPECT_LT(r.max_dH, 2e-4);   // docs/theory.md §7.12: ≈ 1e-4 (modes not resolved at this dt); measured 9.6e-5
+  EXPECT_LT(r.max_dJ, 1e-5);   // docs/theory.md §7.12: ≈ 1e-5; measured 8e-8
 }
 
 TEST(EmGeneralizedAlpha, EnergyErrorFallsWithTheTimeStep) {
-  // spec §7.12: over 0.08 s with v0 = 0, |ΔH|/H ≈ 5e-9 at Δt = 0.002 and 5e-10 at Δt = 0.001.
+  // docs/theory.md §7.12: over 0.08 s with v0 = 0, |ΔH|/H ≈ 5e-9 at Δt = 0.002 and 5e-10 at Δt = 0.001.
   const FlightResult a = fly("em-galpha", 1e6, 0.002, 40, Eigen::Vector3d::Zero(), kW, 0.5);
   const FlightResult b = fly("em-galpha", 1e6, 0.001, 80, Eigen::Vector3d::Zero(), kW, 0.5);
   std::printf("dt 0.002: final %.3e max %.3e; dt 0.001: final %.3e max %.3e\n", a.final_dH, a.max_dH, b.final_dH, b.max_dH);
@@ -154,7 +154,7 @@ TEST(EmGeneralizedAlpha, LinearMomentumIsConservedForEveryParameterChoice) {
 }
 
 TEST(EmGeneralizedAlpha, DissipativeSettingsNeverAddEnergy) {
-  // spec §7.12: ρ∞ = 0.8 or ξ = 0.05 over 100 steps of 0.02: about 4 % energy loss, no growth.
+  // docs/theory.md §7.12: ρ∞ = 0.8 or ξ = 0.05 over 100 steps of 0.02: about 4 % energy loss, no growth.
   for (auto [rho, xi] : {std::pair{0.8, 0.0}, {1.0, 0.05}}) {
     const FlightResult r = fly("em-galpha", 1e6, 0.02, 100, kV0, kW, 0.5,
                                {{"rho_inf", std::to_string(rho)}, {"xi", std::to_string(xi)}});
@@ -166,7 +166,7 @@ TEST(EmGeneralizedAlpha, DissipativeSettingsNeverAddEnergy) {
 }
 
 TEST(EmGeneralizedAlpha, DirectorSwitchingCausesNoEnergyJump) {
-  // spec §7.12: ω = (3, 0.4, 0.2), β = 0.3, Δt = 0.002, 500 steps: 30 switches, |ΔH|/H ≈ 1e-7.
+  // docs/theory.md §7.12: ω = (3, 0.4, 0.2), β = 0.3, Δt = 0.002, 500 steps: 30 switches, |ΔH|/H ≈ 1e-7.
   const FlightResult r = fly("em-galpha", 1e6, 0.002, 500, kV0, Eigen::Vector3d(3.0, 0.4, 0.2), 0.3);
   std::printf("switching run: %ld switches, max|dH|/H %.3e, largest step change at switches %.2e, elsewhere %.2e\n",
               r.switches, r.max_dH, r.max_jump_at_switch, r.max_jump_elsewhere);
