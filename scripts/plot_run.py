@@ -153,7 +153,7 @@ def main():
             axk.set_title(f"{k}  (range {span:.3g})", fontsize=9)
             axk.ticklabel_format(axis="y", style="sci", scilimits=(-3, 4), useOffset=False)
             if col == 0:
-                axk.set_ylabel(f"{name} [{unit}]")
+                axk.set_ylabel(f"{name}\n{sym} [{unit}]", fontsize=9)
             if row == 1:
                 axk.set_xlabel(tlabel)
             axk.grid(alpha=0.3)
