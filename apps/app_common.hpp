@@ -1,7 +1,7 @@
 // What the three benchmark apps (flying_plate, cylindrical_panel, pinched_hemisphere) share, so that
 // each app stays a short tutorial (style.md habit 5): the common command line, input validation before
 // anything is written, locating case files and plot scripts, the run itself (run_dynamic), the plots
-// (scripts/plot_run.py) and a linearised eigen-period estimate.
+// (scripts/plot_run.py) and the measured period of a signal.
 //
 // Errors: every bad input ends in ONE line "<app>: error: <what, where, how to fix>" on stderr and a
 // non-zero exit (1 bad input / failed run, 2 command-line syntax). Inputs are validated before the
@@ -53,11 +53,6 @@ std::pair<std::string, std::string> split_setting(const std::string& kv, const s
 // e.g. "em-galpha", "galpha_rho_inf=0.8", "em-galpha_dt=0.002". Characters other than
 // [A-Za-z0-9._=+-] are replaced by '-'.
 std::string run_label(const std::string& integrator, const std::vector<std::pair<std::string, std::string>>& overrides);
-
-// Lowest non-rigid linearised eigen-periods 2π/ω of K(q0) φ = ω² M(q0) φ on the free DOFs at the
-// reference state (shift-invert subspace iteration; rigid-body modes, ω² below 1e-6 of the shift,
-// are skipped). Returns up to `count` periods in ascending order of ω.
-std::vector<double> linearised_periods(const Problem& problem, int count);
 
 // Period of a signal y(t) over t >= t_from from its upward crossings of the window mean, with a
 // Schmitt trigger at ±25 % of the half range (ignores higher-mode ripple). Returns 0 when fewer than

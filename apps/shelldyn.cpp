@@ -18,6 +18,7 @@
 // add_check_command: it registers its options and, in its callback, stores the action to run.
 // main() stays unchanged apart from one call.
 #include "apps/app_common.hpp"
+#include "apps/modes_command.hpp"
 #include "integrators/runs/compare.hpp"
 #include "integrators/runs/registry.hpp"
 #include "integrators/integrator.hpp"
@@ -390,6 +391,7 @@ int main(int argc, char** argv) {
   add_check_command(app, action, command);
   add_run_command(app, action, command);
   add_static_command(app, action, command);
+  app::add_modes_command(app, action, command);
   add_compare_command(app, action, command);
 
   try {

@@ -10,6 +10,7 @@ PACKAGES=(
   libopenblas0-pthread                 # fast BLAS for CHOLMOD's supernodal factorization
   libeigen3-dev                        # Eigen 3.4
   libyaml-cpp-dev libcli11-dev         # case files, command line
+  libspectra-dev                       # Spectra: shift-invert Lanczos of `shelldyn modes` (header-only)
   libgtest-dev libgmock-dev            # unit tests
   libbenchmark-dev                     # performance programs
   python3 python3-meshio               # VTU round-trip check in the test suite
