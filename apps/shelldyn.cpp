@@ -272,7 +272,7 @@ int run_static_command(const CheckOptions& o) {
 void add_static_command(CLI::App& app, Action& action, const std::string& command) {
   auto opts = std::make_shared<CheckOptions>();
   opts->command = command;
-  CLI::App* sub = app.add_subcommand("static", "Solve a static case by load stepping (integrator: static); write static.csv, VTU/PVD, run.json");
+  CLI::App* sub = app.add_subcommand("static", "Solve a static case (integrator: static; control: load, arc_length or displacement, docs/statics.md); write static.csv, VTU/PVD, run.json");
   sub->add_option("case", opts->case_path, "Case file (YAML), e.g. apps/cases/sze-hemisphere.yaml")->required();
   sub->add_option("-o,--output", opts->out_dir, "Result folder (default: results/<case>/static)");
   sub->callback([opts, &action] { action = [opts] { return run_static_command(*opts); }; });
