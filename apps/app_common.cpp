@@ -5,6 +5,9 @@
 #include "integrators/integrator.hpp"
 #include "integrators/integrator_settings.hpp"
 #include "integrators/runs/run_driver.hpp"
+#ifdef SHELLDYN_HAVE_MPI
+#include "integrators/runs/mpi_executor.hpp"
+#endif
 
 
 #include <spawn.h>
@@ -17,6 +20,7 @@
 #include <filesystem>
 #include <iostream>
 #include <sstream>
+#include <stdexcept>
 
 extern char** environ;
 
@@ -24,6 +28,20 @@ namespace fs = std::filesystem;
 
 namespace shelldyn {
 namespace app {
+
+std::unique_ptr<RunExecutor> make_sweep_executor(int jobs, int threads) {
+  if (launched_by_mpi()) {
+#ifdef SHELLDYN_HAVE_MPI
+    return make_mpi_executor(threads);
+#else
+    throw std::runtime_error(
+        "started by an MPI launcher, but this shelldyn was built without MPI (SHELLDYN_WITH_MPI=OFF): run the sweep "
+        "without mpirun/srun (--jobs N), or install libopenmpi-dev and rebuild");
+#endif
+  }
+  return make_local_executor(jobs, threads);
+}
+
 namespace {
 
 #ifndef SHELLDYN_SOURCE_DIR

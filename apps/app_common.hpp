@@ -9,12 +9,14 @@
 // leaves run.json with status "incomplete: <reason>" (never "complete") and no plots.
 #pragma once
 
+#include "integrators/runs/executor.hpp"
 #include "lib/case_file.hpp"
 #include "lib/problem.hpp"
 
 #include <CLI/CLI.hpp>
 
 #include <functional>
+#include <memory>
 #include <string>
 #include <utility>
 #include <vector>
@@ -42,6 +44,14 @@ bool run_python_script(const std::string& script, const std::vector<std::string>
 // Throws std::invalid_argument unless `dir` can be created or written: it must not be an existing
 // file, and its nearest existing ancestor must be a writable folder. Creates nothing.
 void check_output_folder(const std::string& dir);
+
+// Where a sweep's runs execute (integrators/runs/executor.hpp), for `shelldyn compare` and other sweep
+// commands: under an MPI launcher (mpirun -n P ..., srun ...) the P ranks (dynamic assignment, rank 0
+// collects; `threads` OpenMP threads per run, 0 → 1, `jobs` ignored); otherwise `jobs` worker threads.
+// Launched by MPI but built without it (SHELLDYN_WITH_MPI=OFF) is an error, since every rank would run
+// the whole sweep into the same folders. Call at most once per process (MPI is initialized here and
+// finalized when the executor is destroyed).
+std::unique_ptr<RunExecutor> make_sweep_executor(int jobs, int threads);
 
 // Throws std::invalid_argument naming the registered integrators if `name` is not one of them.
 void check_integrator_name(const std::string& name);
