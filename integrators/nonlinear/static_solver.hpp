@@ -8,11 +8,11 @@
 // with the tangent K(u) − sym ∂F_ext/∂u, factorized by the project's LinearSolver (an LDLᵀ back-end by
 // default, whose negative pivots give the inertia of the tangent), and the scale-aware ConvergenceTest of
 // integrators/nonlinear/path_following.hpp. Director charts are re-selected between steps
-// (spec/element.md §2.3), never inside a Newton solve.
+// (docs/theory.md §2.3), never inside a Newton solve.
 //
 // Controls:
 //   load:          λ stepped to the multiples of `increment` (reported levels); a failed increment
-//                  (no convergence, or the director overshoot guard |q| ≥ 1 of spec/element.md §2.1) is
+//                  (no convergence, or the director overshoot guard |q| ≥ 1 of docs/theory.md §2.1) is
 //                  halved and retried, and grows again after easy increments. Cannot pass a limit point:
 //                  a step that passes one is REPORTED (critical_points), never silent: the inertia of the
 //                  converged tangent changes, or the Newton iterates of the step crossed an indefinite
