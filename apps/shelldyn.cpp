@@ -290,11 +290,12 @@ void add_static_command(CLI::App& app, Action& action, const std::string& comman
   opts->command = command;
   CLI::App* sub = app.add_subcommand(
       "static",
-      "Solve a static case by load stepping (integrator: static); write static.csv, VTU/PVD, run.json.\n"
-      "Case settings (integrator: {name: static, ...}; docs/manual.md §3): increment=time.dt (load-factor step), "
-      "min_increment=increment*1e-4, growth=1.5, easy_iterations=6, hysteresis=1, max_iters=30, tol=1e-9 "
-      "(max-norm residual relative to the applied load), linear_solver=eigen-ldlt (klu: full non-symmetric "
-      "follower-load tangent), line_search=false. The load factor runs from 0 to time.t_end.");
+      "Solve a static case (integrator: static); write static.csv, VTU/PVD, run.json.\n"
+      "Case settings (integrator: {name: static, ...}; docs/statics.md): control=load|arc_length|displacement, "
+      "increment=time.dt, min_increment, growth=1.5, easy_iterations=6, target_iterations=5, max_arc_factor=4, "
+      "max_steps=1000, max_iters=30, tol=1e-8 (residual relative to max(|F_ext|, |F_int| incl. reactions)), "
+      "step_tol=1e-10 (correction relative to the displacement scale), jump_ratio=5, linear_solver=eigen-ldlt (klu: "
+      "full non-symmetric follower-load tangent, no inertia), control_set/control_dof/displacement_end, hysteresis=1.");
   sub->add_option("case", opts->case_path, "Case file (YAML), e.g. apps/cases/sze-hemisphere.yaml")->required();
   sub->add_option("-o,--output", opts->out_dir, "Result folder (default: results/<case>/static)");
   sub->callback([opts, &action] { action = [opts] { return run_static_command(*opts); }; });

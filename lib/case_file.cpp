@@ -182,7 +182,8 @@ MeshSpec parse_mesh(const Parser& p, const YAML::Node& n, const std::string& bas
     return MeshFileSpec{fs::absolute(path).lexically_normal().string()};
   }
   const YAML::Node gen = n["generator"];
-  const size_t kind = p.choice(gen, "mesh.generator", {"rectangle", "cell_union", "cylindrical_panel", "hemisphere"});
+  const size_t kind = p.choice(gen, "mesh.generator", {"rectangle", "cell_union", "cylindrical_panel", "hemisphere",
+                                                       "cylinder_patch", "closed_cylinder", "slit_annulus"});
   switch (kind) {
     case 0: {
       p.check_keys(n, "mesh", {"generator", "a", "b", "nx", "ny", "x0", "y0"}, {"a", "b", "nx", "ny"});
@@ -224,6 +225,37 @@ MeshSpec parse_mesh(const Parser& p, const YAML::Node& n, const std::string& bas
       s.length = p.positive(n["length"], "mesh.length");
       s.n_arc = p.count(n["n_arc"], "mesh.n_arc");
       s.n_axial = p.count(n["n_axial"], "mesh.n_axial");
+      return s;
+    }
+    case 4: {
+      p.check_keys(n, "mesh", {"generator", "radius", "angle", "length", "n_arc", "n_axial"},
+                   {"radius", "angle", "length", "n_arc", "n_axial"});
+      CylinderPatchMeshSpec s;
+      s.radius = p.positive(n["radius"], "mesh.radius");
+      s.angle = p.positive(n["angle"], "mesh.angle");
+      if (s.angle > 3.141592653589793) p.fail(n["angle"], "mesh.angle", "must be <= pi (opening angle in radians from the plane Y = 0)");
+      s.length = p.positive(n["length"], "mesh.length");
+      s.n_arc = p.count(n["n_arc"], "mesh.n_arc");
+      s.n_axial = p.count(n["n_axial"], "mesh.n_axial");
+      return s;
+    }
+    case 5: {
+      p.check_keys(n, "mesh", {"generator", "radius", "length", "n_circ", "n_axial"}, {"radius", "length", "n_circ", "n_axial"});
+      ClosedCylinderMeshSpec s;
+      s.radius = p.positive(n["radius"], "mesh.radius");
+      s.length = p.positive(n["length"], "mesh.length");
+      s.n_circ = p.count(n["n_circ"], "mesh.n_circ");
+      s.n_axial = p.count(n["n_axial"], "mesh.n_axial");
+      return s;
+    }
+    case 6: {
+      p.check_keys(n, "mesh", {"generator", "r_inner", "r_outer", "n_radial", "n_circ"}, {"r_inner", "r_outer", "n_radial", "n_circ"});
+      SlitAnnulusMeshSpec s;
+      s.r_inner = p.positive(n["r_inner"], "mesh.r_inner");
+      s.r_outer = p.positive(n["r_outer"], "mesh.r_outer");
+      if (!(s.r_outer > s.r_inner)) p.fail(n["r_outer"], "mesh.r_outer", "must be > r_inner");
+      s.n_radial = p.count(n["n_radial"], "mesh.n_radial");
+      s.n_circ = p.count(n["n_circ"], "mesh.n_circ");
       return s;
     }
     default: {
@@ -581,7 +613,8 @@ CaseSpec parse_document(const Parser& p, const YAML::Node& root, const std::stri
 
 // ---------------------------------------------------------------------------------------------------
 const char* mesh_kind_name(const MeshSpec& mesh) {
-  static const char* names[] = {"rectangle", "cell_union", "cylindrical_panel", "hemisphere", "file"};
+  static const char* names[] = {"rectangle",      "cell_union",      "cylindrical_panel", "hemisphere",
+                                "file",           "cylinder_patch",  "closed_cylinder",   "slit_annulus"};
   return names[mesh.index()];
 }
 

@@ -224,6 +224,12 @@ Mesh build_mesh(const CaseSpec& spec) {
             return make_cylindrical_panel(m.radius, m.angle, m.length, m.n_arc, m.n_axial);
           else if constexpr (std::is_same_v<T, HemisphereMeshSpec>)
             return make_hemisphere(m.radius, m.hole_deg, m.quarter, m.n);
+          else if constexpr (std::is_same_v<T, CylinderPatchMeshSpec>)
+            return make_cylinder_patch(m.radius, m.angle, m.length, m.n_arc, m.n_axial);
+          else if constexpr (std::is_same_v<T, ClosedCylinderMeshSpec>)
+            return make_closed_cylinder(m.radius, m.length, m.n_circ, m.n_axial);
+          else if constexpr (std::is_same_v<T, SlitAnnulusMeshSpec>)
+            return make_slit_annulus(m.r_inner, m.r_outer, m.n_radial, m.n_circ);
           else
             return read_gmsh(m.path);
         },

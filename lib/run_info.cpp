@@ -153,6 +153,13 @@ void write_mesh(JsonOut& j, const MeshSpec& mesh) {
     } else if (const auto* h = std::get_if<HemisphereMeshSpec>(&mesh)) {
       j.num("radius", h->radius), j.num("hole_deg", h->hole_deg), j.boolean("quarter", h->quarter);
       j.integer("n", h->n);
+    } else if (const auto* q = std::get_if<CylinderPatchMeshSpec>(&mesh)) {
+      j.num("radius", q->radius), j.num("angle", q->angle), j.num("length", q->length);
+      j.integer("n_arc", q->n_arc), j.integer("n_axial", q->n_axial);
+    } else if (const auto* c2 = std::get_if<ClosedCylinderMeshSpec>(&mesh)) {
+      j.num("radius", c2->radius), j.num("length", c2->length), j.integer("n_circ", c2->n_circ), j.integer("n_axial", c2->n_axial);
+    } else if (const auto* a = std::get_if<SlitAnnulusMeshSpec>(&mesh)) {
+      j.num("r_inner", a->r_inner), j.num("r_outer", a->r_outer), j.integer("n_radial", a->n_radial), j.integer("n_circ", a->n_circ);
     }
   }
   j.close_object();
