@@ -209,7 +209,7 @@ struct RunCommandOptions {
   double dt = 0.0, t_end = -1.0, output_every = 0.0, max_wall = 0.0;
   int vtu_every = -1, threads = 0;
   long long max_steps = 0;
-  bool quiet = false, overwrite = false;
+  bool quiet = false, overwrite = false, plots = false;
   CLI::App* cli = nullptr;  // to ask which flags were given
   bool given(const char* flag) const {
     const CLI::Option* opt = cli ? cli->get_option_no_throw(flag) : nullptr;
@@ -265,8 +265,23 @@ int run_run(const RunCommandOptions& o) {
   ro.log = o.quiet ? nullptr : &std::cout;
   std::cout << "shelldyn run: " << problem.spec.name << " with " << integrator_name << " -> " << ro.out_dir << std::endl;
   const RunSummary s = run_dynamic(problem, ro);
-  print_run_summary(std::cout, s);
-  std::cout << "wrote " << ro.out_dir << "/history.csv, " << ro.out_dir << "/fields.pvd, " << ro.out_dir << "/run.json\n";
+  if (o.quiet) {  // one line: status, steps, energy error after the loads
+    std::printf("%s: %s, %ld steps, max |H - H_ref|/(K+V)_ref after loads %.3g -> %s\n", integrator_name.c_str(),
+                s.status.c_str(), s.totals.steps, s.max_rel_drift, ro.out_dir.c_str());
+  } else {
+    print_run_summary(std::cout, s);
+    std::cout << "wrote " << ro.out_dir << "/history.csv, " << ro.out_dir << "/fields.pvd, " << ro.out_dir << "/run.json\n";
+  }
+  if (o.plots) {  // scripts/plot_run.py: energy.png, momentum.png, monitors.png (docs/manual.md §4)
+    for (const char* png : {"energy.png", "momentum.png", "monitors.png"}) {
+      std::error_code ec;
+      fs::remove(fs::path(ro.out_dir) / png, ec);
+    }
+    if (!app::run_python_script(app::find_script("plot_run.py"), {ro.out_dir, "--title", problem.spec.name + ", " + integrator_name},
+                                std::cout))
+      return 1;
+    if (!o.quiet) std::cout << "wrote " << ro.out_dir << "/energy.png, momentum.png, monitors.png\n";
+  }
   return 0;
 }
 
@@ -285,13 +300,14 @@ void add_run_command(CLI::App& app, Action& action, const std::string& command) 
   sub->add_option("--output-every", o->output_every, "Output interval in time units (default: the case's time.output_interval)");
   sub->add_option("--vtu-every", o->vtu_every, "Write a VTU every N output times; 0 disables (default: the case's output.vtu_every)");
   sub->add_option("--threads", o->threads, "OpenMP threads for element loops (default: all cores)");
+  sub->add_flag("-q,--quiet", o->quiet, "No progress line and no summary table: one result line (errors still reported)");
+  sub->add_flag("--plots", o->plots, "After the run, write energy.png, momentum.png, monitors.png with scripts/plot_run.py (needs python3-matplotlib)");
   sub->add_option("--checkpoint-every", o->checkpoint_every,
                   "Write DIR/checkpoint.cbor every N steps, Ts of simulated time (e.g. 0.5s) or Ww seconds of wall "
                   "time (e.g. 60w); off disables (default 60w)");
   sub->add_option("--max-steps", o->max_steps, "Stop (resumable, exit 4) at the first output time after N steps (default 0: no limit)");
   sub->add_option("--max-wall", o->max_wall, "Stop (resumable, exit 4) after S seconds of wall time (default 0: no limit)");
   sub->add_flag("--overwrite", o->overwrite, "Replace the results of an earlier run in the result folder");
-  sub->add_flag("-q,--quiet", o->quiet, "No progress lines");
   o->cli = sub;
   sub->callback([o, &action] { action = [o] { return run_run(*o); }; });
 }
@@ -353,7 +369,14 @@ int run_static_command(const CheckOptions& o) {
 void add_static_command(CLI::App& app, Action& action, const std::string& command) {
   auto opts = std::make_shared<CheckOptions>();
   opts->command = command;
-  CLI::App* sub = app.add_subcommand("static", "Solve a static case by load stepping (integrator: static); write static.csv, VTU/PVD, run.json");
+  CLI::App* sub = app.add_subcommand(
+      "static",
+      "Solve a static case (integrator: static); write static.csv, VTU/PVD, run.json.\n"
+      "Case settings (integrator: {name: static, ...}; docs/statics.md): control=load|arc_length|displacement, "
+      "increment=time.dt, min_increment, growth=1.5, easy_iterations=6, target_iterations=5, max_arc_factor=4, "
+      "max_steps=1000, max_iters=30, tol=1e-8 (residual relative to max(|F_ext|, |F_int| incl. reactions)), "
+      "step_tol=1e-10 (correction relative to the displacement scale), jump_ratio=5, linear_solver=eigen-ldlt (klu: "
+      "full non-symmetric follower-load tangent, no inertia), control_set/control_dof/displacement_end, hysteresis=1.");
   sub->add_option("case", opts->case_path, "Case file (YAML), e.g. apps/cases/sze-hemisphere.yaml")->required();
   sub->add_option("-o,--output", opts->out_dir, "Result folder (default: results/<case>/static)");
   sub->add_flag("--overwrite", opts->overwrite, "Replace the results of an earlier command in the result folder");

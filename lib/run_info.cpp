@@ -95,6 +95,13 @@ Json mesh_json(const MeshSpec& mesh) {
   } else if (const auto* h = std::get_if<HemisphereMeshSpec>(&mesh)) {
     j["radius"] = number(h->radius), j["hole_deg"] = number(h->hole_deg), j["quarter"] = h->quarter;
     j["n"] = h->n;
+  } else if (const auto* q = std::get_if<CylinderPatchMeshSpec>(&mesh)) {
+    j["radius"] = number(q->radius), j["angle"] = number(q->angle), j["length"] = number(q->length);
+    j["n_arc"] = q->n_arc, j["n_axial"] = q->n_axial;
+  } else if (const auto* c2 = std::get_if<ClosedCylinderMeshSpec>(&mesh)) {
+    j["radius"] = number(c2->radius), j["length"] = number(c2->length), j["n_circ"] = c2->n_circ, j["n_axial"] = c2->n_axial;
+  } else if (const auto* a = std::get_if<SlitAnnulusMeshSpec>(&mesh)) {
+    j["r_inner"] = number(a->r_inner), j["r_outer"] = number(a->r_outer), j["n_radial"] = a->n_radial, j["n_circ"] = a->n_circ;
   }
   return j;
 }
@@ -160,6 +167,9 @@ std::string run_json(const CaseSpec& c, const RunInfo& info) {
     bcs.push_back({{"set", bc.set}, {"fix", std::move(fix)}});
   }
   Json& iv = cs["initial_velocity"];
+  iv["set"] = c.initial_velocity.set;
+  if (!c.initial_velocity.field.empty()) iv["field"] = c.initial_velocity.field;
+  if (!c.initial_velocity_more.empty()) iv["further_entries"] = c.initial_velocity_more.size();
   iv["translation"] = vec3(c.initial_velocity.translation);
   iv["angular"] = vec3(c.initial_velocity.angular);
   iv["about"] = c.initial_velocity.about_centroid ? Json("centroid") : vec3(c.initial_velocity.about);
@@ -176,6 +186,7 @@ std::string run_json(const CaseSpec& c, const RunInfo& info) {
                      {"amplitude", number(l.amplitude)}, {"distribution", load_distribution_name(l.distribution)},
                      {"function", std::move(f)}});
   }
+  cs["damping"] = {{"mass", number(c.damping.mass)}, {"stiffness", number(c.damping.stiffness)}};
   Json& integ = cs["integrator"];
   integ["name"] = c.integrator.name;
   for (const auto& [k, x] : c.integrator.settings) integ[k] = x;
@@ -183,8 +194,12 @@ std::string run_json(const CaseSpec& c, const RunInfo& info) {
                 {"output_interval", number(c.time.output_interval)}, {"num_steps", c.time.num_steps()}};
   cs["output"] = {{"vtu", c.output.vtu}, {"vtu_every", c.output.vtu_every}, {"history", c.output.history}};
   Json& mons = cs["monitors"] = Json::array();
-  for (const auto& m : c.monitors)
-    mons.push_back({{"name", m.name}, {"set", m.set}, {"quantity", monitor_quantity_name(m.quantity)}});
+  for (const auto& m : c.monitors) {
+    Json e = {{"name", m.name}, {"set", m.set}, {"quantity", monitor_quantity_name(m.quantity)},
+              {"reduce", monitor_reduce_name(m.reduce)}};
+    if (m.has_axis) e["axis"] = {{"point", vec3(m.axis_point)}, {"direction", vec3(m.axis_direction)}};
+    mons.push_back(std::move(e));
+  }
 
   j["discretization"] = fields(info.discretization);
   j["summary"] = fields(info.summary);

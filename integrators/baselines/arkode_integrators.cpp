@@ -7,7 +7,7 @@
 #include <fcntl.h>
 #include <unistd.h>
 
-#include <cstdio>  // arkode_butcher.h uses FILE without including it (stack.md §2.2)
+#include <cstdio>  // arkode_butcher.h uses FILE without including it (docs/dependencies.md §2.2)
 #include <arkode/arkode_arkstep.h>
 #include <arkode/arkode_butcher_dirk.h>
 #include <arkode/arkode_butcher_erk.h>
@@ -75,10 +75,10 @@ class ArkodeIntegrator final : public Integrator {
     }
     if (B == nullptr)
       throw std::invalid_argument(name_ + ": unknown " + (implicit ? "DIRK" : "ERK") + " table '" + table_ +
-                                  "' (SUNDIALS 6.4.1 names, see below)\ne.g. " +
+                                  "' (SUNDIALS 6.4.1 names)\ne.g. " +
                                   (implicit ? "ARKODE_ESDIRK547L2SA_7_4_5, ARKODE_SDIRK_5_3_4"
                                             : "ARKODE_DORMAND_PRINCE_7_4_5, ARKODE_VERNER_8_5_6") +
-                                  ")");
+                                  "; full list: docs/dependencies.md §4.4");
     const bool embedded = B->d != nullptr;
     ARKodeButcherTable_Free(B);
     if (!embedded && !fixed_)
@@ -422,7 +422,7 @@ class ArkodeIntegrator final : public Integrator {
       f[2 * n] = power;
       return 0;
     } catch (const std::domain_error& e) {
-      // Non-finite stage or director overshoot (spec/element.md §2.1 guard): adaptive steppers retry
+      // Non-finite stage or director overshoot (docs/theory.md §2.1 guard): adaptive steppers retry
       // with a smaller step; a fixed step cannot, so stop with the reason.
       if (!self->fixed_) return 1;
       try {
@@ -454,7 +454,7 @@ class ArkodeIntegrator final : public Integrator {
     }
   }
 
-  // Every accepted step: a non-finite state means the step was unstable (stack.md §7 item 11).
+  // Every accepted step: a non-finite state means the step was unstable (docs/dependencies.md §7 item 11).
   static int after_step(sunrealtype t, N_Vector y, void* ud) {
     auto* self = static_cast<ArkodeIntegrator*>(ud);
     if (all_finite(N_VGetArrayPointer(y), 2 * self->n_ + 1)) return 0;

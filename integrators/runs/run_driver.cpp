@@ -4,6 +4,7 @@
 
 #include "integrators/sundials/sundials_info.hpp"
 #include "lib/history_writer.hpp"
+#include "lib/reactions.hpp"
 #include "lib/run_info.hpp"
 #include "lib/state_output.hpp"
 
@@ -18,6 +19,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <iostream>
 #include <limits>
 #include <memory>
 #include <sstream>
@@ -122,8 +124,10 @@ struct DriverNumbers {
   bool& have_ref;
   long long& out_index;
   long long& k_next;
+  double& E_seen;  // scale of rel_drift while loads act (observe())
   template <class F>
   void each(F&& f) {
+    f("E_seen", E_seen);
     double ref = have_ref ? 1.0 : 0.0, oi = static_cast<double>(out_index), kn = static_cast<double>(k_next);
     f("have_ref", ref), f("out_index", oi), f("k_next", kn);
     f("H0", sum.H0), f("H_ref", sum.H_ref), f("E_ref", sum.E_ref), f("t_ref", sum.t_ref), f("H_final", sum.H_final);
@@ -286,10 +290,12 @@ RunSummary run_dynamic(Problem& problem, const RunOptions& o) {
     write_run_json(run_json_path, spec, info);
     std::vector<std::string> names;
     for (const auto& m : monitors) names.push_back(m.name);
+    // damping_work: energy dissipated by Rayleigh damping (docs/theory.md §8.5), only for damped models.
+    const std::vector<std::string> extra = model.has_damping() ? std::vector<std::string>{"damping_work"} : std::vector<std::string>{};
     if (spec.output.history)
-      history = resume ? std::make_unique<HistoryWriter>(o.out_dir + "/history.csv", std::vector<std::string>{}, names,
+      history = resume ? std::make_unique<HistoryWriter>(o.out_dir + "/history.csv", extra, names,
                                                          static_cast<long long>(resume->number("history_bytes")))
-                       : std::make_unique<HistoryWriter>(o.out_dir + "/history.csv", std::vector<std::string>{}, names);
+                       : std::make_unique<HistoryWriter>(o.out_dir + "/history.csv", extra, names);
     if (vtu_every > 0) pvd = std::make_unique<PvdWriter>(o.out_dir + "/fields.pvd");
   }
 
@@ -301,6 +307,12 @@ RunSummary run_dynamic(Problem& problem, const RunOptions& o) {
   Eigen::Vector3d L_ref = Eigen::Vector3d::Zero(), J_ref = Eigen::Vector3d::Zero();
   double last_print = -1.0;
   long long out_index = 0, k_next = 1;
+  // Progress (docs/manual.md §1): one line updated in place on a terminal (every 0.2 s of wall time);
+  // otherwise a plain line at every 10 % of the simulated time.
+  const bool tty = o.log && ((o.log == &std::cout && isatty(STDOUT_FILENO)) || (o.log == &std::cerr && isatty(STDERR_FILENO)));
+  bool line_open = false;
+  double next_plain_t = 0.0;
+  double E_seen = 0.0;  // largest K + V or |W_ext| so far: the scale of the energy balance while loads act
   double wall_before = 0.0;  // wall time of the run before its last resume
   const long long n_out = static_cast<long long>(std::ceil(t_end / out_dt - 1e-9));
   if (resume) {
@@ -311,7 +323,7 @@ RunSummary run_dynamic(Problem& problem, const RunOptions& o) {
       throw std::runtime_error("the checkpoint does not fit this case's model (" + std::to_string(state.u.size()) + " DOFs)");
     model.adopt_charts(state.charts);
     integrator->restore(model, state, resume->integrator_data);
-    DriverNumbers{sum, have_ref, out_index, k_next}.each([&](const char* key, double& x) { x = resume->number(key); });
+    DriverNumbers{sum, have_ref, out_index, k_next, E_seen}.each([&](const char* key, double& x) { x = resume->number(key); });
     L_ref = resume->vector("L_ref");
     J_ref = resume->vector("J_ref");
     wall_before = resume->number("wall_s");
@@ -347,7 +359,8 @@ RunSummary run_dynamic(Problem& problem, const RunOptions& o) {
     integrator->save(c.integrator_data);
     long long oi = out_index, kn = next_k;
     bool hr = have_ref;
-    DriverNumbers{sum, hr, oi, kn}.each([&](const char* key, double& x) { c.numbers[key] = x; });
+    double es = E_seen;
+    DriverNumbers{sum, hr, oi, kn, es}.each([&](const char* key, double& x) { c.numbers[key] = x; });
     c.vectors["L_ref"] = L_ref;
     c.vectors["J_ref"] = J_ref;
     c.numbers["wall_s"] = elapsed();
@@ -395,7 +408,8 @@ RunSummary run_dynamic(Problem& problem, const RunOptions& o) {
 
   auto observe = [&](const StepReport& rep, bool last) {
     const Invariants inv = model.invariants(state);
-    const double H = inv.kinetic + inv.strain - integrator->external_work();
+    const double H = inv.kinetic + inv.strain - integrator->external_work() + integrator->damping_work();
+    E_seen = std::max({E_seen, inv.kinetic + inv.strain, std::abs(integrator->external_work())});
     if (out_index == 0) sum.H0 = H;
     if (!have_ref && state.t >= loads_end - 1e-12 * dt) {
       have_ref = true;
@@ -409,7 +423,9 @@ RunSummary run_dynamic(Problem& problem, const RunOptions& o) {
       sum.ref_L = L_ref.norm();
       sum.ref_J = J_ref.norm();
     }
-    double drift = std::numeric_limits<double>::quiet_NaN();
+    // rel_drift (docs/manual.md §4): while loads act, the error of the discrete energy balance
+    // (H − H0)/max(K + V, |W_ext|) so far; after the loads, (H − H_ref)/(K + V)_ref.
+    double drift = E_seen > 0.0 ? (H - sum.H0) / E_seen : 0.0;
     if (have_ref) {
       const double scale = sum.E_ref > 0.0 ? sum.E_ref : (std::abs(sum.H_ref) > 0.0 ? std::abs(sum.H_ref) : 1.0);
       drift = (H - sum.H_ref) / scale;
@@ -423,7 +439,11 @@ RunSummary run_dynamic(Problem& problem, const RunOptions& o) {
     sum.H_final = H;
     const double wall = elapsed();
     std::vector<double> mon;
-    for (const auto& m : monitors) mon.push_back(monitor_value(m, model.mesh(), state.u, state.v, state.charts));
+    const bool vtu_now = pvd && out_index % vtu_every == 0;
+    Eigen::VectorXd R;  // reaction forces (docs/theory.md §9.2), for monitors rx..rz and the VTU
+    if (vtu_now || monitors_need_reactions(monitors)) R = reactions(model, state, true);
+    for (const auto& m : monitors)
+      mon.push_back(monitor_value(m, model.mesh(), state.u, state.v, state.charts, R.size() ? &R : nullptr));
     if (history) {
       HistoryRow row;
       row.step = sum.totals.steps;
@@ -440,23 +460,31 @@ RunSummary run_dynamic(Problem& problem, const RunOptions& o) {
       row.linear_setups = sum.totals.linear_setups;
       row.wall_s = wall;
       row.monitors = mon;
+      if (model.has_damping()) row.extra = {integrator->damping_work()};
       history->write(row);
     }
-    if (pvd && out_index % vtu_every == 0) {
+    if (vtu_now) {
       const std::string file = "fields/" + vtu_step_file_name(out_index);
-      write_vtu(o.out_dir + "/" + file, model.mesh(), state_fields(model, state));
+      write_vtu(o.out_dir + "/" + file, model.mesh(), state_fields(model, state, &R));
       pvd->add(state.t, file);
     }
-    if (o.log && (last || wall - last_print >= 0.2)) {
+    const bool due = tty ? (last || wall - last_print >= 0.2) : (last || out_index == 0 || state.t >= next_plain_t);
+    if (o.log && due) {
       last_print = wall;
+      while (next_plain_t <= state.t) next_plain_t += 0.1 * t_end > 0.0 ? 0.1 * t_end : 1.0;
       const double eta = state.t > 0.0 ? wall * (t_end - state.t) / state.t : 0.0;
-      char buf[320];
-      std::snprintf(buf, sizeof buf,
-                    "%s%s t = %.6g/%.6g  steps %ld  iters %ld  K %.6g  V %.6g  H %.10g  drift %s  wall %.1f s  ETA %.0f s",
-                    o.label.empty() ? "" : o.label.c_str(), o.label.empty() ? "" : " |", state.t, t_end,
-                    sum.totals.steps, sum.totals.nonlinear_iterations, inv.kinetic, inv.strain, H,
-                    std::isnan(drift) ? "(loads on)" : (std::to_string(drift)).c_str(), wall, eta);
-      *o.log << buf << std::endl;
+      char dr[48];
+      std::snprintf(dr, sizeof dr, have_ref ? "drift %+.2e" : "balance %+.2e (loads on)", drift);
+      char buf[360];
+      std::snprintf(buf, sizeof buf, "%s%st = %.6g/%.6g  steps %ld  iters %ld  K %.4e  V %.4e  H %.6e  %s  wall %.1f s  ETA %.0f s",
+                    o.label.c_str(), o.label.empty() ? "" : " | ", state.t, t_end, sum.totals.steps,
+                    sum.totals.nonlinear_iterations, inv.kinetic, inv.strain, H, dr, wall, eta);
+      if (tty) {
+        *o.log << '\r' << buf << "\x1b[K" << (last ? "\n" : "") << std::flush;
+        line_open = !last;
+      } else {
+        *o.log << buf << std::endl;
+      }
     }
     if (last)
       for (size_t k = 0; k < monitors.size(); ++k) sum.final_monitors.emplace_back(monitors[k].name, mon[k]);
@@ -524,6 +552,8 @@ RunSummary run_dynamic(Problem& problem, const RunOptions& o) {
         } else {
           resume_hint = files ? "; no checkpoint (not supported by this integrator)" : "";
         }
+        if (line_open) *o.log << std::endl;  // end the in-place status line before the message
+        line_open = false;
         const std::string msg = stop_reason + where + resume_hint;
         const std::string json_error = write_status(msg);
         throw RunStopped(msg + (json_error.empty() ? "" : "; " + json_error), stop_code);
@@ -543,6 +573,7 @@ RunSummary run_dynamic(Problem& problem, const RunOptions& o) {
   } catch (const RunStopped&) {
     throw;
   } catch (const std::exception& e) {
+    if (line_open) *o.log << std::endl;  // end the in-place status line before the error message
     const std::string json_error = write_status(std::string("incomplete: ") + e.what());
     if (!json_error.empty()) throw std::runtime_error(std::string(e.what()) + "; " + json_error);
     throw;
