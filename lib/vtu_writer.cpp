@@ -34,15 +34,25 @@ class File {
   explicit File(const std::string& path) : path_(path), f_(std::fopen(path.c_str(), "w")) {
     if (!f_) throw std::runtime_error(path + ": cannot create file: " + std::strerror(errno));
   }
-  ~File() {
-    if (f_) std::fclose(f_);
+  ~File() {  // not closed: an exception interrupted the write; leave no half-written file behind
+    if (f_) {
+      std::fclose(f_);
+      std::remove(path_.c_str());
+    }
   }
   std::FILE* get() const { return f_; }
   void close() {
-    const bool bad = std::ferror(f_) != 0;
+    errno = 0;
+    const bool bad = std::fflush(f_) != 0 || std::ferror(f_) != 0;
+    const int err = errno;
     const int rc = std::fclose(f_);
     f_ = nullptr;
-    if (bad || rc != 0) throw std::runtime_error(path_ + ": write error: " + std::strerror(errno));
+    if (bad || rc != 0) {
+      const int e = err ? err : errno;
+      std::remove(path_.c_str());
+      throw std::runtime_error(path_ + ": cannot write: " +
+                               (e == ENOSPC ? std::string("the disk is full (free space and rerun)") : std::strerror(e)));
+    }
   }
 
  private:
@@ -63,8 +73,14 @@ void write_vectors(std::FILE* f, const char* name, const std::vector<Vec3>& v) {
 }
 
 void write_scalars(std::FILE* f, const ScalarField& s) {
-  std::fprintf(f, "        <DataArray type=\"Float64\" Name=\"%s\" format=\"ascii\">\n", xml_escape(s.name).c_str());
-  for (double v : s.values) std::fprintf(f, "          %.17g\n", v);
+  std::fprintf(f, "        <DataArray type=\"Float64\" Name=\"%s\" NumberOfComponents=\"%d\" format=\"ascii\">\n",
+               xml_escape(s.name).c_str(), s.components);
+  const size_t nc = static_cast<size_t>(s.components);
+  for (size_t k = 0; k < s.values.size(); k += nc) {
+    std::fprintf(f, "         ");
+    for (size_t c = 0; c < nc; ++c) std::fprintf(f, " %.17g", s.values[k + c]);
+    std::fprintf(f, "\n");
+  }
   std::fprintf(f, "        </DataArray>\n");
 }
 
@@ -83,13 +99,15 @@ void write_vtu(const std::string& path, const Mesh& mesh, const VtuFields& field
   check_size(fields.director.size(), np, "director");
   std::set<std::string> names = {"displacement", "velocity", "director"};
   for (const auto& s : fields.point_scalars) {
-    check_size(s.values.size(), np, "point field '" + s.name + "'");
+    if (s.components < 1) throw std::invalid_argument("write_vtu: field '" + s.name + "' has < 1 component");
+    check_size(s.values.size(), np * static_cast<size_t>(s.components), "point field '" + s.name + "'");
     if (s.name.empty() || !names.insert(s.name).second)
       throw std::invalid_argument("write_vtu: point field name '" + s.name + "' is empty or repeated");
   }
   std::set<std::string> cell_names;
   for (const auto& s : fields.cell_scalars) {
-    check_size(s.values.size(), ne, "cell field '" + s.name + "'");
+    if (s.components < 1) throw std::invalid_argument("write_vtu: field '" + s.name + "' has < 1 component");
+    check_size(s.values.size(), ne * static_cast<size_t>(s.components), "cell field '" + s.name + "'");
     if (s.name.empty() || !cell_names.insert(s.name).second)
       throw std::invalid_argument("write_vtu: cell field name '" + s.name + "' is empty or repeated");
   }

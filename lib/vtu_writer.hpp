@@ -20,7 +20,8 @@ namespace shelldyn {
 
 struct ScalarField {
   std::string name;
-  std::vector<double> values;  // one per point (point data) or per element (cell data)
+  std::vector<double> values;  // `components` per point (point data) or per element (cell data)
+  int components = 1;          // > 1: a vector/tensor field, values interleaved per point/element
 };
 
 struct VtuFields {
@@ -45,6 +46,8 @@ class PvdWriter {
   // relative to the .pvd's folder, e.g. "fields/step_000010.vtu". Throws std::runtime_error on I/O errors.
   void add(double time, const std::string& file);
   const std::vector<std::pair<double, std::string>>& entries() const { return entries_; }
+  // Resume (checkpoint restart): the entries up to the checkpoint; the file is rewritten at the next add().
+  void restore(std::vector<std::pair<double, std::string>> entries) { entries_ = std::move(entries); }
   const std::string& path() const { return path_; }
 
  private:

@@ -4,7 +4,10 @@
 #include "integrators/sundials/sundials_support.hpp"
 #include "lib/assembler.hpp"
 
-#include <cstdio>  // arkode_butcher.h uses FILE without including it (stack.md §2.2)
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <cstdio>  // arkode_butcher.h uses FILE without including it (docs/dependencies.md §2.2)
 #include <arkode/arkode_arkstep.h>
 #include <arkode/arkode_butcher_dirk.h>
 #include <arkode/arkode_butcher_erk.h>
@@ -42,14 +45,24 @@ class ArkodeIntegrator final : public SundialsBaseline {
       if (max_nonlin_ < 1) throw std::invalid_argument(name_ + ": max_nonlin_iters must be >= 1");
     }
     // Validate the table now, so that a typo is a settings error, not a failure at initialize().
-    ARKodeButcherTable B = implicit ? ARKodeButcherTable_LoadDIRKByName(table_.c_str())
-                                    : ARKodeButcherTable_LoadERKByName(table_.c_str());
+    ARKodeButcherTable B = nullptr;
+    {  // SUNDIALS prints its own "[ARKODE ERROR] ... Unknown Butcher table" lines: keep stderr to one line
+      std::fflush(stderr);
+      const int saved = dup(2);
+      const int null = open("/dev/null", O_WRONLY);
+      if (saved >= 0 && null >= 0) dup2(null, 2);
+      B = implicit ? ARKodeButcherTable_LoadDIRKByName(table_.c_str()) : ARKodeButcherTable_LoadERKByName(table_.c_str());
+      std::fflush(stderr);
+      if (saved >= 0 && null >= 0) dup2(saved, 2);
+      if (null >= 0) close(null);
+      if (saved >= 0) close(saved);
+    }
     if (B == nullptr)
       throw std::invalid_argument(name_ + ": unknown " + (implicit ? "DIRK" : "ERK") + " table '" + table_ +
-                                  "' (SUNDIALS 6.4.1 names, e.g. " +
+                                  "' (SUNDIALS 6.4.1 names)\ne.g. " +
                                   (implicit ? "ARKODE_ESDIRK547L2SA_7_4_5, ARKODE_SDIRK_5_3_4"
                                             : "ARKODE_DORMAND_PRINCE_7_4_5, ARKODE_VERNER_8_5_6") +
-                                  "; see docs/architecture.md)");
+                                  "; full list: docs/dependencies.md §4.4");
     const bool embedded = B->d != nullptr;
     ARKodeButcherTable_Free(B);
     if (!embedded && !fixed_)
@@ -297,7 +310,7 @@ class ArkodeIntegrator final : public SundialsBaseline {
       f[2 * n] = power;
       return 0;
     } catch (const std::domain_error& e) {
-      // Non-finite stage or director overshoot (spec/element.md §2.1 guard): adaptive steppers retry
+      // Non-finite stage or director overshoot (docs/theory.md §2.1 guard): adaptive steppers retry
       // with a smaller step; a fixed step cannot, so stop with the reason.
       if (!self->fixed_) return 1;
       try {
@@ -328,7 +341,7 @@ class ArkodeIntegrator final : public SundialsBaseline {
     }
   }
 
-  // Every accepted step: a non-finite state means the step was unstable (stack.md §7 item 11).
+  // Every accepted step: a non-finite state means the step was unstable (docs/dependencies.md §7 item 11).
   static int after_step(sunrealtype t, N_Vector y, void* ud) {
     auto* self = static_cast<ArkodeIntegrator*>(ud);
     if (all_finite(N_VGetArrayPointer(y), 2 * self->n_ + 1)) return 0;

@@ -3,7 +3,7 @@
 //
 //     ẏ = f(t, y) = [ v ;  M(q)⁻¹ (F_ext − F_int − F_m) ;  F_ext·v ]
 //
-// ARKStep's mass matrix cannot depend on y in SUNDIALS 6.4.1 (stack.md §4.5), so M(q) is factorized
+// ARKStep's mass matrix cannot depend on y in SUNDIALS 6.4.1 (docs/dependencies.md §4.5), so M(q) is factorized
 // inside every RHS evaluation (mass_solver: eigen-ldlt|cholmod, one symbolic analysis per run);
 // constrained DOFs get v̇_c = 0.
 //
@@ -26,7 +26,7 @@
 //
 // Step control: adaptive (rtol, atol) by default; `fixed_step: true` takes steps of the case's dt
 // (ARKStepSetFixedStep). Explicit fixed-step runs past the stability limit would silently produce NaN
-// (stack.md §7 item 11): a post-step hook checks every step and the run stops with a StepFailure.
+// (docs/dependencies.md §7 item 11): a post-step hook checks every step and the run stops with a StepFailure.
 //
 // Director charts, tolerances, progress output and the evolve / root-event / re-init loop: shared with
 // ida-bdf (integrators/baselines/sundials_baseline.hpp).

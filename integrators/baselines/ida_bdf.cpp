@@ -230,7 +230,7 @@ class IdaBdf final : public SundialsBaseline {
       rv[2 * n] = ypv[2 * n] - power;
       return 0;
     } catch (const std::domain_error&) {
-      return 1;  // director overshoot (spec/element.md §2.1 guard) or non-finite: IDA cuts the step
+      return 1;  // director overshoot (docs/theory.md §2.1 guard) or non-finite: IDA cuts the step
     } catch (...) {
       self->errors_.capture("ida-bdf residual");
       return -1;
@@ -275,7 +275,7 @@ class IdaBdf final : public SundialsBaseline {
         val[pv] = -self->fext_[j];  // ∂(ẇ − F_ext·v)/∂v_j
       }
       val[bcol[2 * n]] = cj;
-      copy_to_sun_matrix(self->big_, J);  // IDA zeroed J, structure included (stack.md §3.2)
+      copy_to_sun_matrix(self->big_, J);  // IDA zeroed J, structure included (docs/dependencies.md §3.2)
       return 0;
     } catch (const std::domain_error&) {
       return 1;

@@ -58,10 +58,10 @@ void SundialsBaseline::initialize(SemiDiscreteSystem& system, State& state) {
   n_ = system.num_dofs();
   if (!ctx_) ctx_ = std::make_unique<SunContext>();  // one context per integrator object
   fos_ = std::make_unique<FirstOrderSystem>(system, mass_solver_, mass_reuse_);
-  // A director past its chart's margin at the start: switch first (spec/element.md §2.3).
+  // A director past its chart's margin at the start: switch first (docs/theory.md §2.3).
   if (system.chart_margin(state) < 0.0) system.rechart(state);
   fos_->acceleration(state.t, state, state.a);
-  w_ = 0.0;
+  w_ = w_out_ = 0.0;
   t_ = state.t;
   work_ = state;
 
@@ -84,6 +84,19 @@ void SundialsBaseline::initialize(SemiDiscreteSystem& system, State& state) {
   last_progress_ = std::chrono::steady_clock::now();
 }
 
+void SundialsBaseline::save(IntegratorCheckpoint& c) const {
+  c.exact = false;
+  c.scalars["W_ext"] = w_out_;
+}
+
+void SundialsBaseline::restore(SemiDiscreteSystem& system, State& state, const IntegratorCheckpoint& c) {
+  if (!fos_) throw std::logic_error(name_ + ": restore() before initialize()");
+  sys_ = &system;
+  w_ = w_out_ = c.scalar("W_ext");
+  StepReport ignored;
+  restart_from(state, ignored);
+}
+
 void SundialsBaseline::restart_from(State& s, StepReport& rep) {
   add_counters(rep);
   t_ = s.t;
@@ -101,9 +114,12 @@ void SundialsBaseline::progress(double t_out, const StepReport& rep) {
   if (std::chrono::duration<double>(now - last_progress_).count() < progress_every_) return;
   last_progress_ = now;
   char buf[256];
-  std::snprintf(buf, sizeof buf, "%s | (inside the output interval) t = %.6g -> %.6g  step %.3g  steps %ld  evaluations %ld",
+  std::snprintf(buf, sizeof buf, "%s | (inside the output interval) t = %.6g -> %.6g  step size %.3g  steps %ld and evaluations %ld in this interval",
                 progress_label_.c_str(), t_, t_out, last_step(), rep.steps, rep.rhs_evaluations);
-  *progress_log_ << buf << std::endl;
+  if (progress_in_place_)
+    *progress_log_ << '\r' << buf << "\x1b[K" << std::flush;
+  else
+    *progress_log_ << buf << std::endl;
 }
 
 StepReport SundialsBaseline::advance(SemiDiscreteSystem& system, State& state, double t_out) {
@@ -135,6 +151,12 @@ StepReport SundialsBaseline::advance(SemiDiscreteSystem& system, State& state, d
       add_counters(rep);
       fail(0, tret, "non-finite solution");
     }
+    if (stop_requested()) {  // signal or --max-wall: abandon the interval, `state` stays the last output state
+      add_counters(rep);
+      std::ostringstream os;
+      os << name_ << ": stopped on request at t = " << t_ << " (state kept at t = " << state.t << ")";
+      throw RunInterrupted(os.str());
+    }
     const StepOutcome what = outcome(flag);
     if (what == StepOutcome::reached) break;
     if (what == StepOutcome::root) {
@@ -164,6 +186,7 @@ StepReport SundialsBaseline::advance(SemiDiscreteSystem& system, State& state, d
   t_ = t_out;
   if (!acceleration_in_y()) fos_->acceleration(t_, work_, work_.a);  // state.a = v̇(t_out)
   state = work_;
+  w_out_ = w_;
   rep.last_dt = last_step();
   rep.factorizations = factorizations() - fact0;
   rep.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();

@@ -42,10 +42,17 @@ class SundialsBaseline : public Integrator {
   std::string name() const override { return name_; }
   std::vector<std::pair<std::string, std::string>> settings() const override;
   double external_work() const override { return w_; }
-  void set_progress_log(std::ostream* log, const std::string& label) override {
+  void set_progress_log(std::ostream* log, const std::string& label, bool in_place = false) override {
     progress_log_ = log;
     progress_label_ = label;
+    progress_in_place_ = in_place;
   }
+  // Checkpoint by re-initialization (docs/architecture.md "Checkpoints and resume"): only W_ext at the
+  // last output time is saved; restore() restarts SUNDIALS from the saved State as after a chart event.
+  // The step-size and order history is lost, so a resumed run agrees with an uninterrupted one to the
+  // tolerances (rtol, atol), not bitwise.
+  void save(IntegratorCheckpoint& c) const override;
+  void restore(SemiDiscreteSystem& system, State& state, const IntegratorCheckpoint& c) override;
   void initialize(SemiDiscreteSystem& system, State& state) final;
   StepReport advance(SemiDiscreteSystem& system, State& state, double t_out) final;
 
@@ -96,6 +103,8 @@ class SundialsBaseline : public Integrator {
 
   std::ostream* progress_log_ = nullptr;
   std::string progress_label_;
+  bool progress_in_place_ = false;
+  double w_out_ = 0.0;  // W_ext at the end of the last advance() (checkpoints)
   std::chrono::steady_clock::time_point last_progress_;
 };
 

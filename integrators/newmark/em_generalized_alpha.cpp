@@ -13,8 +13,8 @@ namespace shelldyn {
 
 GeneralizedAlphaParameters generalized_alpha_parameters(double rho_inf) {
   if (!(rho_inf >= 0.0 && rho_inf <= 1.0))
-    throw std::invalid_argument("rho_inf = " + std::to_string(rho_inf) + " is outside [0, 1]");
-  // spec/element.md §6.1 (Chung–Hulbert; Kuhl–Crisfield GEMM convention x_{n+1−α} = (1−α)x_{n+1} + α x_n).
+    throw std::invalid_argument((std::ostringstream() << "rho_inf = " << rho_inf << " is outside [0, 1]").str());
+  // docs/theory.md §6.1 (Chung–Hulbert; Kuhl–Crisfield GEMM convention x_{n+1−α} = (1−α)x_{n+1} + α x_n).
   GeneralizedAlphaParameters p;
   p.alpha_m = (2.0 * rho_inf - 1.0) / (rho_inf + 1.0);
   p.alpha_f = rho_inf / (rho_inf + 1.0);
@@ -31,14 +31,19 @@ class NewmarkFamily final : public Integrator {
  public:
   NewmarkFamily(Scheme scheme, std::string name, IntegratorSettings& s, double dt)
       : scheme_(scheme), name_(std::move(name)), dt_(dt) {
+    auto g = [](double x) {
+      char b[32];
+      std::snprintf(b, sizeof b, "%.10g", x);
+      return std::string(b);
+    };
     if (!(dt > 0.0) || !std::isfinite(dt)) throw std::invalid_argument(name_ + ": time step dt must be > 0");
     if (scheme_ == Scheme::Newmark) {
       p_.alpha_m = p_.alpha_f = 0.0;
       p_.beta = s.get("beta", 0.25);
       p_.gamma = s.get("gamma", 0.5);
       if (!(p_.beta > 0.0) || !(p_.gamma >= 0.5))
-        throw std::invalid_argument(name_ + ": need beta > 0 and gamma >= 0.5 (got beta = " +
-                                    std::to_string(p_.beta) + ", gamma = " + std::to_string(p_.gamma) + ")");
+        throw std::invalid_argument(name_ + ": need beta > 0 and gamma >= 0.5 (got beta = " + g(p_.beta) + ", gamma = " +
+                                    g(p_.gamma) + ")");
     } else {
       p_ = generalized_alpha_parameters(s.get("rho_inf", 1.0));
     }
@@ -49,7 +54,7 @@ class NewmarkFamily final : public Integrator {
     // Full Newton by default. Modified Newton (reuse of K̄ over iterations and steps) cuts the cost per step
     // by 2-3x on the flying plate at the same iteration count, but it diverges when stiff elements turn
     // fast as rigid bodies (the rotated elastic stiffness leaks into the soft rigid-body directions of a
-    // stale K̄: the spinning plate of benchmarks.md §6 fails at its first step). So a step that fails under
+    // stale K̄: the spinning plate of docs/benchmarks.md §6 fails at its first step). So a step that fails under
     // modified Newton is retried with full Newton before any step cutting.
     const std::string newton = s.get("newton", "full");
     if (newton != "full" && newton != "modified")
@@ -61,7 +66,7 @@ class NewmarkFamily final : public Integrator {
     // on a loaded machine (benchmarks/bench_model_step.cpp).
     nopt_.linear_solver = s.get("linear_solver", "eigen-ldlt");
     make_linear_solver(nopt_.linear_solver);  // validate the name now, not at the first step
-    // Paper eq. 39 (spec/element.md §6.5): stop when cc = |Δu^(k+1)·P̄^(k)| / |Δu^(1)·P̄^(0)| ≤ cc_tol.
+    // Paper eq. 39 (docs/theory.md §6.5): stop when cc = |Δu^(k+1)·P̄^(k)| / |Δu^(1)·P̄^(0)| ≤ cc_tol.
     // Default 1e-12, far tighter than the paper's 1e-6: conservation studies need the algebraic error well
     // below the time-discretization error (with 1e-8 a tumbling plate drifts by 3e-7 in 2000 steps, with
     // 1e-12 it stays at 4e-9). Because cc ∝ |Δu|², quadratic convergence makes this cost about one extra
@@ -81,13 +86,9 @@ class NewmarkFamily final : public Integrator {
     max_cuts_ = s.get("max_cuts", 0);
     hysteresis_ = s.get("hysteresis", 1.0);
     if (!(nopt_.energy_tol > 0.0) || nopt_.max_iters < 1 || nopt_.min_iters < 0 || max_cuts_ < 0 || hysteresis_ < 1.0)
-      throw std::invalid_argument(name_ + ": need cc_tol > 0, max_iters >= 1, min_iters >= 0, max_cuts >= 0, hysteresis >= 1");
+      throw std::invalid_argument(name_ + ": out-of-range Newton settings (limits below)\nneed cc_tol > 0, max_iters >= 1, "
+                                  "min_iters >= 0, max_cuts >= 0, hysteresis >= 1");
     resolved_ = s.resolved();
-    auto g = [](double x) {
-      char b[32];
-      std::snprintf(b, sizeof b, "%.10g", x);
-      return std::string(b);
-    };
     resolved_.insert(resolved_.begin(), {{"dt", g(dt_)}, {"alpha_m", g(p_.alpha_m)}, {"alpha_f", g(p_.alpha_f)},
                                          {"beta", g(p_.beta)}, {"gamma", g(p_.gamma)}});
   }
@@ -95,6 +96,43 @@ class NewmarkFamily final : public Integrator {
   std::string name() const override { return name_; }
   std::vector<std::pair<std::string, std::string>> settings() const override { return resolved_; }
   double external_work() const override { return work_; }
+  double damping_work() const override { return damping_work_; }
+
+  // Checkpoint (docs/architecture.md "Checkpoints and resume"): besides the State (u, v, a, charts)
+  // a step depends on W_ext, the step counter (messages), the last step size (modified Newton
+  // refreshes K̄ when it changes) and, with modified Newton, the K̄ in use and the iterations done with
+  // it. restore() makes the next setup replay that K̄ (same values, hence the same factorization)
+  // and resume the refresh count, so the continued run is bitwise the uninterrupted one.
+  void save(IntegratorCheckpoint& c) const override {
+    if (!newton_) throw std::logic_error(name_ + ": save() before initialize()");
+    c.exact = true;
+    c.scalars["W_ext"] = work_;
+    c.scalars["W_damp"] = damping_work_;
+    c.scalars["steps"] = static_cast<double>(steps_);
+    c.scalars["last_h"] = last_h_;
+    const int since = nopt_.modified ? newton_->iterations_since_setup() : -1;
+    c.scalars["newton_since_setup"] = since;
+    if (since >= 0) c.vectors["kbar"] = Eigen::Map<const Eigen::VectorXd>(kbar_.data(), static_cast<Index>(kbar_.size()));
+  }
+
+  void restore(SemiDiscreteSystem& sys, State& s, const IntegratorCheckpoint& c) override {
+    if (!newton_) throw std::logic_error(name_ + ": restore() before initialize()");
+    if (s.u.size() != sys.num_dofs() || s.v.size() != sys.num_dofs() || s.a.size() != sys.num_dofs())
+      throw std::runtime_error(name_ + ": checkpoint state has the wrong size for this model");
+    work_ = c.scalar("W_ext");
+    damping_work_ = c.scalar("W_damp");
+    steps_ = static_cast<long>(c.scalar("steps"));
+    last_h_ = c.scalar("last_h");
+    const int since = static_cast<int>(c.scalar("newton_since_setup"));
+    replay_kbar_ = false;
+    if (nopt_.modified && since >= 0) {
+      const Eigen::VectorXd& k = c.vector("kbar");
+      if (k.size() != sys.pattern()->nnz()) throw std::runtime_error(name_ + ": checkpoint K̄ has the wrong size");
+      kbar_.assign(k.data(), k.data() + k.size());
+      replay_kbar_ = true;
+      newton_->resume_after_setup(since);
+    }
+  }
 
   void initialize(SemiDiscreteSystem& sys, State& s) override {
     const Index n = sys.num_dofs();
@@ -103,9 +141,9 @@ class NewmarkFamily final : public Integrator {
     K_ = M_;
     for (Eigen::VectorXd* v : {&un_, &vn_, &an_, &umid_, &vmid_, &amid_, &fint_, &fm_, &fext_, &fint_n_, &fext_n_, &tmp_})
       v->setZero(n);
-    work_ = 0.0;
+    work_ = damping_work_ = 0.0;
     sys.rechart(s, hysteresis_);
-    // Consistent initial acceleration (spec/element.md §6.4 start-up): M(u0) a0 = F_ext − F_int − F_m.
+    // Consistent initial acceleration (docs/theory.md §6.4 start-up): M(u0) a0 = F_ext − F_int − F_m.
     sys.mass(s.u, s.charts, M_);
     sys.internal(s.u, s.charts, fint_.data(), nullptr);
     sys.inertial(s.u, s.v, s.charts, fm_.data());
@@ -126,6 +164,7 @@ class NewmarkFamily final : public Integrator {
       double h = std::min(dt_, t_out - s.t);
       if (t_out - (s.t + h) < 1e-9 * dt_) h = t_out - s.t;  // land exactly on t_out
       step_with_cuts(sys, s, h, 0, rep);
+      if (stop_requested()) break;  // at a step boundary: the driver checkpoints and stops
     }
     rep.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return rep;
@@ -152,10 +191,14 @@ class NewmarkFamily final : public Integrator {
     step_with_cuts(sys, s, 0.5 * h, depth + 1, rep);
   }
 
-  // One step of size h from s (spec/element.md §6.6). Returns false (s unchanged but for charts) on failure.
+  // One step of size h from s (docs/theory.md §6.6). Returns false (s unchanged but for charts) on failure.
   bool step(SemiDiscreteSystem& sys, State& s, double h, StepReport& rep, std::string* why, bool full_newton = false) {
     rep.chart_switches += sys.rechart(s, hysteresis_);  // §2.3: between steps only
-    if (h != last_h_) newton_->invalidate_jacobian();   // K̄ depends on h (modified Newton)
+    if (h != last_h_) {  // K̄ depends on h (modified Newton)
+      newton_->invalidate_jacobian();
+      if (replay_kbar_) newton_->resume_after_setup(0);  // a saved K̄ for another h is of no use
+      replay_kbar_ = false;
+    }
     last_h_ = h;
     if (full_newton && !full_newton_) {
       NewtonOptions full = nopt_;
@@ -217,7 +260,14 @@ class NewmarkFamily final : public Integrator {
       zero_constrained(sys.dofs(), r);
       if (!rr.allFinite()) throw std::runtime_error("non-finite residual");
     };
+    bool replayed = false;
     auto jacobian = [&](const double* u, SparseMatrix& J) {
+      if (replay_kbar_ && !full_newton) {  // first setup after restore(): the saved K̄, not a new one
+        J.values = kbar_;
+        replay_kbar_ = false;
+        replayed = true;
+        return;
+      }
       const Eigen::Map<const Eigen::VectorXd> uu(u, n);
       midpoint_state(u);
       sys.mass(umid_, charts, M_);
@@ -238,7 +288,9 @@ class NewmarkFamily final : public Integrator {
       }
       // §6.4: K̄ = (1−α_m)/(βΔt²) M_mid + (1−α_f) K_mid (symmetric; the (1−α_m) reading of §6.8 item 3).
       for (size_t k = 0; k < J.values.size(); ++k) J.values[k] = du * M_.values[k] + (1 - af) * K_.values[k];
+      sys.add_damping_matrix(cu, J);  // ∂(C u̇_mid)/∂u_{n+1} (docs/theory.md §8.5)
       apply_dirichlet(sys.dofs(), J, nullptr);
+      if (nopt_.modified && !full_newton) kbar_ = J.values;  // for save()
     };
 
     Eigen::VectorXd u = un_;  // predictor u_{n+1}^(0) = u_n (§6.4)
@@ -246,8 +298,9 @@ class NewmarkFamily final : public Integrator {
     const NewtonSolver::Result r = newton.solve(u.data(), residual, jacobian, nullptr, uscale_.data());
     if (full_newton) newton_->invalidate_jacobian();  // the modified solver's K̄ is stale now
     rep.nonlinear_iterations += r.iterations;
-    rep.linear_setups += r.jacobian_evals;
-    rep.factorizations += r.factorizations;
+    // A replayed K̄ (restore()) is the uninterrupted run's matrix, not a new setup: not counted.
+    rep.linear_setups += r.jacobian_evals - (replayed ? 1 : 0);
+    rep.factorizations += r.factorizations - (replayed ? 1 : 0);
     rep.rhs_evaluations += r.residual_evals;
     rep.residual_norm = r.fnorm;
     rep.energy_ratio = r.energy_ratio;
@@ -255,10 +308,14 @@ class NewmarkFamily final : public Integrator {
       *why = r.message + " (cc = " + std::to_string(r.energy_ratio) + ", iterations = " + std::to_string(r.iterations) + ")";
       return false;
     }
-    // Discrete external work with the scheme's own load evaluation (benchmarks.md §0).
+    // Discrete external work with the scheme's own load evaluation (docs/benchmarks.md §0).
     midpoint_state(u.data());
     external_force(u.data());
     work_ += fext_.dot(u - un_);
+    if (sys.has_damping()) {  // dissipated work Δuᵀ C u̇_mid (docs/theory.md §8.5)
+      sys.damping_force(vmid_, tmp_.data());
+      damping_work_ += tmp_.dot(u - un_);
+    }
     // §6.2 Newmark updates.
     s.a = (u - un_) / (be * h * h) - vn_ / (be * h) - (0.5 / be - 1.0) * an_;
     s.v = vn_ + h * ((1 - ga) * an_ + ga * s.a);
@@ -283,9 +340,11 @@ class NewmarkFamily final : public Integrator {
   std::unique_ptr<NewtonSolver> newton_, full_newton_;  // full_newton_: fallback of modified Newton
   SparseMatrix M_, K_;
   Eigen::VectorXd un_, vn_, an_, umid_, vmid_, amid_, fint_, fm_, fext_, fint_n_, fext_n_, tmp_, uscale_;
-  double work_ = 0.0;
+  double work_ = 0.0, damping_work_ = 0.0;
   double last_h_ = 0.0;
   long steps_ = 0;
+  std::vector<double> kbar_;   // the modified solver's last K̄ (checkpoints)
+  bool replay_kbar_ = false;   // restore(): the next setup of the modified solver uses kbar_
 };
 
 }  // namespace

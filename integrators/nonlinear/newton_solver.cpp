@@ -82,6 +82,7 @@ struct NewtonSolver::Impl {
   // Modified Newton bookkeeping (across solve() calls).
   bool have_jacobian = false, force_setup = false;
   int since_setup = 0;
+  int resume_since_setup = -1;  // checkpoint restart: since_setup after the next setup (-1: 0)
 
   ~Impl() {
     if (kin) KINFree(&kin);
@@ -126,7 +127,7 @@ struct NewtonSolver::Impl {
         throw std::invalid_argument(
             "the Jacobian callback changed the matrix pattern or the size of its value array; fill "
             "J.values only");
-      // KINSOL zeroed Jm including its structure: refill everything (stack.md §3.2 pitfall 2).
+      // KINSOL zeroed Jm including its structure: refill everything (docs/dependencies.md §3.2 pitfall 2).
       copy_to_sun_matrix(s->Jwork, Jm);
       return 0;
     } catch (...) {
@@ -187,6 +188,11 @@ NewtonSolver& NewtonSolver::operator=(NewtonSolver&&) noexcept = default;
 const NewtonOptions& NewtonSolver::options() const { return impl_->opt; }
 const LinearSolver& NewtonSolver::linear_solver() const { return sun_linear_solver_backend(impl_->LS.get()); }
 void NewtonSolver::invalidate_jacobian() { impl_->force_setup = true; }
+int NewtonSolver::iterations_since_setup() const {
+  const Impl& s = *impl_;
+  return s.have_jacobian && !s.force_setup ? s.since_setup : -1;
+}
+void NewtonSolver::resume_after_setup(int k) { impl_->resume_since_setup = k; }
 
 NewtonSolver::Result NewtonSolver::solve(double* u, const Residual& residual, const Jacobian& jacobian,
                                          const double* fscale, const double* uscale,
@@ -290,11 +296,12 @@ NewtonSolver::Result NewtonSolver::solve(double* u, const Residual& residual, co
     if (s.jacobian_evals > jac0) {
       s.have_jacobian = true;
       s.force_setup = false;
-      s.since_setup = 0;
+      s.since_setup = s.resume_since_setup > 0 ? s.resume_since_setup : 0;
+      s.resume_since_setup = -1;
     }
     s.since_setup += static_cast<int>(nni);
 
-    // Energy criterion (element.md §6.5): E = |du · F(u_prev)|.
+    // Energy criterion (docs/theory.md §6.5): E = |du · F(u_prev)|.
     double E = 0;
     for (Index i = 0; i < n; ++i) {
       s.du[i] = uu[i] - s.u_prev[i];

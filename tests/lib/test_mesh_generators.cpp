@@ -115,7 +115,7 @@ TEST(MakeRectangle, RejectsBadParameters) {
   expect_invalid([] { make_rectangle(1.0, 1.0, 100000, 100000); }, "nodes");
 }
 
-// FLP-prov plate of spec/benchmarks.md §1.3: [0,3]x[0,7] u [3,6]x[0,3].
+// FLP-prov plate of docs/benchmarks.md §1.3: [0,3]x[0,7] u [3,6]x[0,3].
 TEST(MakeCellUnion, FlyingLShape) {
   const Mesh m = make_cell_union({{0, 0, 3, 7}, {3, 0, 6, 3}}, 1.0);
   expect_valid_mesh(m);
@@ -159,7 +159,7 @@ TEST(MakeCellUnion, RejectsOverlapDisconnectedAndBadInput) {
   expect_invalid([] { make_cell_union({{0, 0, 1, 1}}, 0.0); }, "'cell'");
 }
 
-// spec/benchmarks.md §2.3 geometry.
+// docs/benchmarks.md §2.3 geometry.
 TEST(MakeCylindricalPanel, CountsExactGeometrySetsNormals) {
   const double R = 150, angle = 0.2, L = 30;
   const Mesh m = make_cylindrical_panel(R, angle, L, 6, 4);
@@ -244,7 +244,7 @@ void expect_on_hemisphere(const Mesh& m, double R, double hole_deg) {
   }
 }
 
-// spec/benchmarks.md §§3.2, 4.4 geometry.
+// docs/benchmarks.md §§3.2, 4.4 geometry.
 TEST(MakeHemisphere, QuarterModel) {
   const double R = 10;
   const int n = 4;
@@ -287,7 +287,7 @@ TEST(MakeHemisphere, FullModelWrapsAroundWithoutDuplicates) {
   const auto p = initial_normals(m);
   for (size_t i = 0; i < p.size(); ++i) EXPECT_GT(p[i].dot(m.X[i] / R), std::cos(0.03)) << "node " << i;
   EXPECT_NO_THROW(check_orientation(m, p));
-  // The benchmark mesh (spec/benchmarks.md §3.2): 4 quarters x 8 x 8 = 256 elements.
+  // The benchmark mesh (docs/benchmarks.md §3.2): 4 quarters x 8 x 8 = 256 elements.
   EXPECT_EQ(make_hemisphere(R, 18.0, false, 8).num_elements(), 256);
 }
 
@@ -317,6 +317,47 @@ TEST(MakeHemisphere, RejectsBadParameters) {
   expect_invalid([] { make_hemisphere(10, 90, true, 4); }, "'hole_deg'");
   expect_invalid([] { make_hemisphere(10, -5, false, 4); }, "'hole_deg'");
   expect_invalid([] { make_hemisphere(10, 18, false, 0); }, "'n'");
+}
+
+}  // namespace
+}  // namespace shelldyn
+
+namespace shelldyn {
+namespace {
+
+// Generators for path-following benchmarks (issue 12): geometry, orientation and sets.
+TEST(MeshGenerators, CylinderPatchSitsAtItsNaturalHeightWithEdgesOnCoordinatePlanes) {
+  const Mesh m = make_cylinder_patch(2540.0, 0.1, 254.0, 4, 3);
+  EXPECT_EQ(m.num_nodes(), 9 * 7);
+  EXPECT_EQ(m.num_elements(), 12);
+  for (const Vec3& x : m.X) EXPECT_NEAR(std::hypot(x.y(), x.z()), 2540.0, 1e-9);
+  for (int i : m.node_sets.at("arc0")) EXPECT_EQ(m.X[static_cast<size_t>(i)].y(), 0.0);  // plane Y = 0
+  for (int i : m.node_sets.at("x0")) EXPECT_EQ(m.X[static_cast<size_t>(i)].x(), 0.0);    // plane X = 0
+  EXPECT_DOUBLE_EQ(m.X[static_cast<size_t>(m.node_sets.at("corner_x0_arc0")[0])].z(), 2540.0);
+  EXPECT_THROW(make_cylinder_patch(1.0, 4.0, 1.0, 4, 4), std::invalid_argument);
+}
+
+TEST(MeshGenerators, ClosedCylinderMergesTheSeam) {
+  const Mesh m = make_closed_cylinder(3.0, 10.0, 8, 4);
+  EXPECT_EQ(m.num_nodes(), 16 * 9);  // 2 n_circ nodes per ring, no duplicate seam
+  EXPECT_EQ(m.num_elements(), 32);
+  for (const Vec3& x : m.X) EXPECT_NEAR(std::hypot(x.y(), x.z()), 3.0, 1e-12);
+  EXPECT_EQ(m.node_sets.at("top").size(), 9u);
+  EXPECT_EQ(m.node_sets.at("bottom").size(), 9u);
+  EXPECT_THROW(make_closed_cylinder(3.0, 10.0, 3, 4), std::invalid_argument);
+}
+
+TEST(MeshGenerators, SlitAnnulusKeepsTheSlitOpen) {
+  const Mesh m = make_slit_annulus(6.0, 10.0, 2, 8);
+  EXPECT_EQ(m.num_nodes(), 5 * 17);  // theta = 0 and 2 pi are distinct nodes
+  const Vec3 a = m.X[static_cast<size_t>(m.node_sets.at("point_A")[0])];
+  const Vec3 b = m.X[static_cast<size_t>(m.node_sets.at("point_B")[0])];
+  EXPECT_EQ(a, Vec3(6.0, 0.0, 0.0));
+  EXPECT_EQ(b, Vec3(10.0, 0.0, 0.0));
+  const auto& s0 = m.node_sets.at("slit_start");
+  const auto& s1 = m.node_sets.at("slit_end");
+  for (size_t k = 0; k < s0.size(); ++k) EXPECT_NE(s0[k], s1[k]);
+  EXPECT_THROW(make_slit_annulus(10.0, 6.0, 2, 8), std::invalid_argument);
 }
 
 }  // namespace
