@@ -11,36 +11,18 @@ Reads COMPARE_DIR/summary.csv and each run's COMPARE_DIR/<label>/history.csv and
 If matplotlib is missing, prints one warning line and exits 0.
 """
 import argparse
-import csv
 import math
 import os
 import sys
 
-
-def read_csv(path):
-    with open(path, newline="", encoding="utf-8") as f:
-        return list(csv.DictReader(f))
+from plot_common import after_loads_row, columns, fnum, loads_end, read_csv
 
 
-def fnum(s):
-    try:
-        return float(s)
-    except (TypeError, ValueError):
-        return math.nan
 
 
-def columns(rows):
-    out = {}
-    for r in rows:
-        for k, v in r.items():
-            out.setdefault(k, []).append(fnum(v))
-    return out
-
-
-def mechanical_drift(h):
-    """(t, |H - H_ref| / (K_ref + V_ref)) after the loads end; ref = first row with a finite rel_drift
-    (the run driver's reference time). H_ref itself is ~0 for a body set in motion by loads."""
-    ref = next((i for i, d in enumerate(h["rel_drift"]) if math.isfinite(d)), None)
+def mechanical_drift(h, ref):
+    """(t, |H - H_ref| / (K_ref + V_ref)) after the loads end; ref = the row of the run driver's reference
+    time (plot_common.after_loads_row). H_ref itself is ~0 for a body set in motion by loads."""
     if ref is None:
         return []
     scale = h["kinetic"][ref] + h["strain"][ref]
@@ -77,15 +59,18 @@ def main():
             case = first.split(":", 1)[1].strip()
     color = {r["label"]: f"C{i % 10}" for i, r in enumerate(runs)}  # one colour per run in every panel
     hists = {}
+    refs = {}  # label -> row of the after-the-loads reference (None: the run ends before the loads do)
     for r in runs:
         p = os.path.join(a.dir, r["label"], "history.csv")
         if r["status"] == "complete" and os.path.isfile(p):
-            hists[r["label"]] = columns(read_csv(p))
+            h = columns(read_csv(p))
+            refs[r["label"]] = after_loads_row(h, loads_end(os.path.dirname(p)))
+            hists[r["label"]] = h
 
     fig, (ax, ax2) = plt.subplots(2, 1, figsize=(7, 6), sharex=True)
     for label, h in hists.items():
         ax.plot(h["t"], h["total"], label=label, lw=1, color=color[label])
-        pts = mechanical_drift(h)
+        pts = mechanical_drift(h, refs[label])
         if pts:
             ax2.semilogy([p[0] for p in pts], [p[1] for p in pts], lw=1, label=label, color=color[label])
     ax.set_ylabel("total energy H")
@@ -102,7 +87,7 @@ def main():
     fig, (a1, a2) = plt.subplots(2, 1, figsize=(7, 6), sharex=True)
     for label, h in hists.items():
         t = h["t"]
-        ref = next((i for i, d in enumerate(h["rel_drift"]) if math.isfinite(d)), None)
+        ref = refs[label]
         if ref is None:
             continue
         for axis, keys in ((a1, ("Lx", "Ly", "Lz")), (a2, ("Jx", "Jy", "Jz"))):

@@ -15,32 +15,15 @@ Energy errors below 1e-16 are drawn at 1e-16 (round-off level) and marked as suc
 If matplotlib is missing, prints one warning line and exits 0.
 """
 import argparse
-import csv
 import math
 import os
 import sys
 
+from plot_common import after_loads_row, columns, fnum, loads_end, read_csv
+
 FLOOR = 1e-16
 
 
-def read_csv(path):
-    with open(path, newline="", encoding="utf-8") as f:
-        return list(csv.DictReader(f))
-
-
-def fnum(s):
-    try:
-        return float(s)
-    except (TypeError, ValueError):
-        return math.nan
-
-
-def columns(rows):
-    out = {}
-    for r in rows:
-        for k, v in r.items():
-            out.setdefault(k, []).append(fnum(v))
-    return out
 
 
 def method_of(label):
@@ -117,9 +100,12 @@ def main():
     # --- full-duration histories -----------------------------------------------------------------------
     full = [r for r in done if r["group"] == "full"]
     hist = {}
+    refs = {}  # label -> row of the after-the-loads reference (None: the run ends before the loads do)
     for r in full:
         try:
-            hist[r["label"]] = columns(read_csv(os.path.join(a.dir, "full", r["label"], "history.csv")))
+            run_dir = os.path.join(a.dir, "full", r["label"])
+            hist[r["label"]] = columns(read_csv(os.path.join(run_dir, "history.csv")))
+            refs[r["label"]] = after_loads_row(hist[r["label"]], loads_end(run_dir))
         except OSError:
             pass
     if hist:
@@ -130,7 +116,7 @@ def main():
                 continue
             m = method_of(r["label"])
             c = colour.get(m, "k")
-            ref = next((i for i, d in enumerate(h["rel_drift"]) if math.isfinite(d)), None)
+            ref = refs[r["label"]]
             ls = "--" if r["kind"] == "baseline" else "-"
             ax2.plot(h["t"], [k + v for k, v in zip(h["kinetic"], h["strain"])], ls, color=c, lw=1.1, label=r["label"])
             if ref is not None:
@@ -155,7 +141,7 @@ def main():
             if not h:
                 continue
             c = colour.get(method_of(r["label"]), "k")
-            ref = next((i for i, d in enumerate(h["rel_drift"]) if math.isfinite(d)), None)
+            ref = refs[r["label"]]
             if ref is None:
                 continue
             ls = "--" if r["kind"] == "baseline" else "-"

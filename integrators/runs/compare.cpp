@@ -1,4 +1,5 @@
 #include "integrators/runs/compare.hpp"
+#include "integrators/runs/number_text.hpp"
 #include "integrators/runs/executor.hpp"
 #include "integrators/runs/registry.hpp"
 
@@ -30,19 +31,8 @@ namespace fs = std::filesystem;
 namespace shelldyn {
 namespace {
 
-std::string num(double x) {
-  if (std::isnan(x)) return "nan";
-  char b[40];
-  std::snprintf(b, sizeof b, "%.6g", x);
-  return b;
-}
-
-std::string full(double x) {
-  if (std::isnan(x)) return "nan";
-  char b[40];
-  std::snprintf(b, sizeof b, "%.17g", x);
-  return b;
-}
+using number_text::full;
+using number_text::num;
 
 std::string one_line(std::string s) {
   for (char& c : s)

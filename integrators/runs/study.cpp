@@ -1,4 +1,5 @@
 #include "integrators/runs/study.hpp"
+#include "integrators/runs/number_text.hpp"
 #include "integrators/runs/registry.hpp"
 
 #include "lib/problem.hpp"
@@ -18,28 +19,11 @@ namespace fs = std::filesystem;
 namespace shelldyn {
 namespace {
 
+using number_text::full;
+using number_text::num;
+using number_text::sci;
+
 const double NaN = std::numeric_limits<double>::quiet_NaN();
-
-std::string num(double x) {
-  if (std::isnan(x)) return "nan";
-  char b[40];
-  std::snprintf(b, sizeof b, "%.6g", x);
-  return b;
-}
-
-std::string sci(double x) {
-  if (std::isnan(x)) return "n/a";
-  char b[40];
-  std::snprintf(b, sizeof b, "%.2e", x);
-  return b;
-}
-
-std::string full(double x) {
-  if (std::isnan(x)) return "nan";
-  char b[40];
-  std::snprintf(b, sizeof b, "%.17g", x);
-  return b;
-}
 
 std::string read_text(const std::string& path) {
   std::ifstream in(path);
@@ -307,6 +291,7 @@ StudyResult run_study(const StudyOptions& o) {
           const CsvTable h = read_csv_table((dir / "history.csv").string());
           row.energy_error = energy_balance_error(h);
           row.energy_error_after_loads = mechanical_energy_drift(h, loads_end);
+          if (std::isnan(row.energy_error_after_loads)) row.max_dL = row.max_dJ = NaN;  // no reference: loads still on
           if (ref_table.count(group) && run.kind != "reference")
             row.displacement_error = monitor_distance(h, ref_table[group], monitors);
         } catch (const std::exception& e) {
