@@ -3,10 +3,12 @@
 #include "integrators/nonlinear/newton_solver.hpp"
 #include "lib/assembler.hpp"
 #include "lib/linear_solver.hpp"
+#include "lib/profile.hpp"
 
 #include <chrono>
 #include <cstdio>
 #include <cmath>
+#include <limits>
 #include <sstream>
 
 namespace shelldyn {
@@ -55,11 +57,28 @@ class NewmarkFamily final : public Integrator {
     if (newton != "full" && newton != "modified")
       throw std::invalid_argument(name_ + ".newton: '" + newton + "' (use full or modified)");
     nopt_.modified = (newton == "modified");
-    nopt_.max_setup_calls = s.get("setup_every", 20);
-    // Eigen's simplicial LDLᵀ by default: on the 5440-unknown hemisphere it factorizes K̄ in about the same
-    // CPU time as CHOLMOD's supernodal Cholesky (21.5 vs 18.7 ms) without CHOLMOD's threading surprises
-    // on a loaded machine (benchmarks/bench_model_step.cpp).
-    nopt_.linear_solver = s.get("linear_solver", "eigen-ldlt");
+    // Refresh of a kept K̄ by observed contraction θ = ‖Δu_k‖/‖Δu_{k−1}‖ (integrators/nonlinear/newton_solver.hpp):
+    // refresh = 0 keeps the fixed count setup_every; refresh > 0 refreshes when θ exceeds it.
+    nopt_.refresh_contraction = s.get("refresh", nopt_.modified ? 0.1 : 0.0);
+    nopt_.max_setup_calls = s.get("setup_every", nopt_.refresh_contraction > 0 ? 1000000 : 20);
+    // Predictor (§6.4 uses u_{n+1}^(0) = u_n): "newmark" starts from the constant-acceleration prediction
+    // u_n + Δt v_n + Δt²/2 a_n, for which the Newmark relations give ü_{n+1}^(0) = a_n.
+    const std::string predictor = s.get("predictor", nopt_.modified ? "newmark" : "none");
+    if (predictor != "none" && predictor != "newmark")
+      throw std::invalid_argument(name_ + ".predictor: '" + predictor + "' (use none or newmark)");
+    newmark_predictor_ = (predictor == "newmark");
+    // Absolute floor of the stopping rule in units of the system's energy: an iterate u_k is accepted once the
+    // work of the remaining residual over the step, |P̄(u_{k−1})·(u_k − u_n)| (the step's contribution to the
+    // error of H), is at most e_floor · ε · E_sys, with ε the machine epsilon and E_sys = K_0 + V_0 + |W_ext|
+    // (the energy the body can hold, H being conserved). Below ε·E_sys the total energy itself is round-off,
+    // so the iteration never asks for less; 0 switches the floor off.
+    e_floor_ = s.get("e_floor", nopt_.modified ? 1.0 : 0.0);
+    if (!(e_floor_ >= 0.0)) throw std::invalid_argument(name_ + ": e_floor must be >= 0");
+    // CHOLMOD's supernodal Cholesky by default (simplicial LDLᵀ if K̄ is ever indefinite, lib/linear_solver.hpp):
+    // with its hidden threads switched off it factorizes the hemisphere's K̄ in ~0.8x and solves in ~0.6x the
+    // CPU time of Eigen's simplicial LDLᵀ, and with a kept factorization the solves dominate
+    // (benchmarks/bench_step_breakdown.cpp).
+    nopt_.linear_solver = s.get("linear_solver", "cholmod");
     make_linear_solver(nopt_.linear_solver);  // validate the name now, not at the first step
     // Paper eq. 39 (spec/element.md §6.5): stop when cc = |Δu^(k+1)·P̄^(k)| / |Δu^(1)·P̄^(0)| ≤ cc_tol.
     // Default 1e-12, far tighter than the paper's 1e-6: conservation studies need the algebraic error well
@@ -70,6 +89,14 @@ class NewmarkFamily final : public Integrator {
     nopt_.stop = StopTest::fnorm_or_energy;
     nopt_.fnorm_tol = 1e-300;
     nopt_.step_tol = s.get("step_tol", 1e-14);
+    // Modified Newton applies the step test itself (in the iteration hook): KINSOL's own test, met with a
+    // stale Jacobian, insists on a refresh and one more iteration, which costs a factorization per step
+    // exactly where the iteration has converged to round-off.
+    // step_refresh = true restores KINSOL's behaviour (refresh and iterate once more with a current K̄): a
+    // factorization per step, and on the cylindrical panel half the energy error of the hook's test.
+    step_tol_ = nopt_.step_tol;
+    step_refresh_ = s.get("step_refresh", false);
+    if (nopt_.modified && !step_refresh_) nopt_.step_tol = 0.0;  // 0: the smallest positive double, i.e. never
     // Modified Newton converges linearly: the error left after the last correction is of the order of that
     // correction, not of its square, so its default tolerance is the square of the full-Newton one. With
     // 1e-12 the flying plate's energy error after the loads is 1.9e-8 and ‖ΔJ‖ 2.4e-6; with 1e-20 they are
@@ -112,6 +139,10 @@ class NewmarkFamily final : public Integrator {
     sys.external(s.t, s.u, s.charts, fext_.data());
     tmp_ = fext_ - fint_ - fm_;
     apply_dirichlet(sys.dofs(), M_, tmp_.data());
+    {
+      const Invariants inv = sys.invariants(s);
+      energy0_ = std::abs(inv.kinetic) + std::abs(inv.strain);
+    }
     auto solver = make_linear_solver(nopt_.linear_solver);
     solver->factorize(M_.view());
     s.a.resize(n);
@@ -155,11 +186,14 @@ class NewmarkFamily final : public Integrator {
   // One step of size h from s (spec/element.md §6.6). Returns false (s unchanged but for charts) on failure.
   bool step(SemiDiscreteSystem& sys, State& s, double h, StepReport& rep, std::string* why, bool full_newton = false) {
     rep.chart_switches += sys.rechart(s, hysteresis_);  // §2.3: between steps only
-    if (h != last_h_) newton_->invalidate_jacobian();   // K̄ depends on h (modified Newton)
+    // K̄ depends on h (modified Newton). Steps that land on an output time differ from dt in the last bits
+    // (t_out − t); that is no reason to throw a factorization away.
+    if (std::abs(h - last_h_) > 1e-8 * h) newton_->invalidate_jacobian();
     last_h_ = h;
     if (full_newton && !full_newton_) {
       NewtonOptions full = nopt_;
       full.modified = false;
+      full.step_tol = step_tol_;  // KINSOL's step test is harmless with a current Jacobian
       full_newton_ = std::make_unique<NewtonSolver>(sys.pattern(), full);
     }
     NewtonSolver& newton = full_newton ? *full_newton_ : *newton_;
@@ -237,13 +271,30 @@ class NewmarkFamily final : public Integrator {
           break;
       }
       // §6.4: K̄ = (1−α_m)/(βΔt²) M_mid + (1−α_f) K_mid (symmetric; the (1−α_m) reading of §6.8 item 3).
+      profile::Scope prof(profile::Section::combine);
       for (size_t k = 0; k < J.values.size(); ++k) J.values[k] = du * M_.values[k] + (1 - af) * K_.values[k];
       apply_dirichlet(sys.dofs(), J, nullptr);
     };
 
     Eigen::VectorXd u = un_;  // predictor u_{n+1}^(0) = u_n (§6.4)
+    if (newmark_predictor_ && !full_newton) u += h * vn_ + (0.5 * h * h) * an_;
     uscale_ = (1.0 / un_.array().abs().max(1.0)).matrix();
-    const NewtonSolver::Result r = newton.solve(u.data(), residual, jacobian, nullptr, uscale_.data());
+    // Scale-aware floor of the energy criterion (constructor): accept u_k once |Δu·P̄| is round-off of H.
+    const double floor = e_floor_ * std::numeric_limits<double>::epsilon() * (energy0_ + std::abs(work_));
+    NewtonSolver::IterationHook hook;
+    if (floor > 0.0 || nopt_.modified)
+      hook = [this, floor, n, &newton, met = 0](int, const double* u, const double* du, const double* f) mutable {
+        const Eigen::Map<const Eigen::VectorXd> d(du, n), r(f, n), uu(u, n);
+        // Energy floor: the work of the remaining residual over the whole step, |P̄(u_{k−1})·(u_k − u_n)|,
+        // is what the step adds to H's error; below ε·E_sys it is round-off of H.
+        if (floor > 0.0 && std::abs(r.dot(uu - un_)) <= floor) return true;
+        // Scaled step test |Δu_i| ≤ step_tol max(1, |u_n,i|) (modified Newton, see the constructor), met on two
+        // consecutive iterations: the second one is the extra iteration KINSOL would have made.
+        if (!newton.options().modified || step_refresh_) return false;
+        met = (d.array().abs() * uscale_.array()).maxCoeff() <= step_tol_ ? met + 1 : 0;
+        return met >= 2;
+      };
+    const NewtonSolver::Result r = newton.solve(u.data(), residual, jacobian, nullptr, uscale_.data(), hook);
     if (full_newton) newton_->invalidate_jacobian();  // the modified solver's K̄ is stale now
     rep.nonlinear_iterations += r.iterations;
     rep.linear_setups += r.jacobian_evals;
@@ -284,6 +335,11 @@ class NewmarkFamily final : public Integrator {
   SparseMatrix M_, K_;
   Eigen::VectorXd un_, vn_, an_, umid_, vmid_, amid_, fint_, fm_, fext_, fint_n_, fext_n_, tmp_, uscale_;
   double work_ = 0.0;
+  double energy0_ = 0.0;  // K + V at initialize() (scale of the energy floor)
+  double e_floor_ = 0.0;
+  double step_tol_ = 1e-14;
+  bool step_refresh_ = false;
+  bool newmark_predictor_ = false;
   double last_h_ = 0.0;
   long steps_ = 0;
 };

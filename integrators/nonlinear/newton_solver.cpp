@@ -51,6 +51,8 @@ void validate(const NewtonOptions& o) {
   if (o.stop != StopTest::fnorm && !(o.energy_tol > 0))
     bad("energy_tol must be > 0 when the energy test is used, got " + std::to_string(o.energy_tol));
   if (!(o.energy_floor >= 0)) bad("energy_floor must be >= 0");
+  if (!(o.refresh_contraction >= 0) || !std::isfinite(o.refresh_contraction))
+    bad("refresh_contraction must be >= 0 (0 = off), got " + std::to_string(o.refresh_contraction));
   const auto names = linear_solver_names();
   if (std::find(names.begin(), names.end(), o.linear_solver) == names.end())
     make_linear_solver(o.linear_solver);  // throws with the list of valid names
@@ -224,6 +226,7 @@ NewtonSolver::Result NewtonSolver::solve(double* u, const Residual& residual, co
 
   Result r;
   double E0 = 0;
+  double du_norm_prev = 0;  // ‖uscale·Δu_{k−1}‖₂ (contraction-based refresh)
   bool energy_ok = false;  // energy test at the current iterate
   int k = 0;               // iterations done
 
@@ -302,6 +305,17 @@ NewtonSolver::Result NewtonSolver::solve(double* u, const Residual& residual, co
     }
     E = std::abs(E);
     if (first_call) E0 = E;
+    // Observed contraction of the (modified) Newton iteration; a poor one asks for a fresh Jacobian.
+    double du_norm = 0;
+    for (Index i = 0; i < n; ++i) du_norm += (us[i] * s.du[i]) * (us[i] * s.du[i]);
+    du_norm = std::sqrt(du_norm);
+    if (!first_call && du_norm_prev > 0) {
+      r.contraction = du_norm / du_norm_prev;
+      if (o.modified && o.refresh_contraction > 0 && r.contraction > o.refresh_contraction &&
+          s.jacobian_evals == jac0)  // this iteration used a stale Jacobian
+        s.force_setup = true;
+    }
+    du_norm_prev = du_norm;
     r.energy_ratio = (E0 <= o.energy_floor) ? 0.0 : E / E0;
     // cc = 1 by definition after the first iteration; only the floor can accept there.
     energy_ok = energy_test && r.energy_ratio <= o.energy_tol && (!first_call || E0 <= o.energy_floor);
