@@ -5,10 +5,10 @@
 #include "integrators/integrator.hpp"
 #include "integrators/integrator_settings.hpp"
 #include "integrators/runs/run_driver.hpp"
+#ifdef SHELLDYN_HAVE_MPI
+#include "integrators/runs/mpi_executor.hpp"
+#endif
 
-#include <Eigen/Dense>
-#include <Eigen/SparseCholesky>
-#include <Eigen/SparseCore>
 
 #include <spawn.h>
 #include <sys/wait.h>
@@ -19,8 +19,8 @@
 #include <cstdlib>
 #include <filesystem>
 #include <iostream>
-#include <random>
 #include <sstream>
+#include <stdexcept>
 
 extern char** environ;
 
@@ -28,6 +28,20 @@ namespace fs = std::filesystem;
 
 namespace shelldyn {
 namespace app {
+
+std::unique_ptr<RunExecutor> make_sweep_executor(int jobs, int threads) {
+  if (launched_by_mpi()) {
+#ifdef SHELLDYN_HAVE_MPI
+    return make_mpi_executor(threads);
+#else
+    throw std::runtime_error(
+        "started by an MPI launcher, but this shelldyn was built without MPI (SHELLDYN_WITH_MPI=OFF): run the sweep "
+        "without mpirun/srun (--jobs N), or install libopenmpi-dev and rebuild");
+#endif
+  }
+  return make_local_executor(jobs, threads);
+}
+
 namespace {
 
 #ifndef SHELLDYN_SOURCE_DIR
@@ -146,67 +160,6 @@ std::string run_label(const std::string& integrator, const std::vector<std::pair
   for (char& c : s)
     if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '.' || c == '_' || c == '=' || c == '+' || c == '-')) c = '-';
   return s;
-}
-
-std::vector<double> linearised_periods(const Problem& problem, int count) {
-  const Model& model = *problem.model;
-  const State s0 = problem.initial_state();
-  SparseMatrix K = model.make_matrix(), M = model.make_matrix();
-  model.internal(s0.u, s0.charts, nullptr, &K);
-  model.mass(s0.u, s0.charts, M);
-  const DofMap& dofs = model.dofs();
-  const Index n = model.num_dofs(), nf = dofs.num_free();
-  if (nf == 0) return {};
-
-  // Free-DOF blocks of K and M; shift sigma between round-off and the lowest elastic ω² (see header).
-  using SpMat = Eigen::SparseMatrix<double>;
-  std::vector<Eigen::Triplet<double>> tk, tm;
-  const SparsePattern& pat = *K.pattern;
-  std::vector<double> ratios;
-  for (Index j = 0; j < n; ++j) {
-    const Index fj = dofs.free_index(j);
-    if (fj < 0) continue;
-    for (Index k = pat.colptr[j]; k < pat.colptr[j + 1]; ++k) {
-      const Index fi = dofs.free_index(pat.rowind[k]);
-      if (fi < 0) continue;
-      tk.emplace_back(static_cast<int>(fi), static_cast<int>(fj), K.values[k]);
-      tm.emplace_back(static_cast<int>(fi), static_cast<int>(fj), M.values[k]);
-      if (fi == fj && M.values[k] > 0.0) ratios.push_back(K.values[k] / M.values[k]);
-    }
-  }
-  SpMat Kf(nf, nf), Mf(nf, nf);
-  Kf.setFromTriplets(tk.begin(), tk.end());
-  Mf.setFromTriplets(tm.begin(), tm.end());
-  std::sort(ratios.begin(), ratios.end());
-  const double sigma = 1e-8 * ratios[ratios.size() / 2];
-  Eigen::SimplicialLDLT<SpMat> solver(SpMat(Kf + sigma * Mf));
-  if (solver.info() != Eigen::Success) throw std::runtime_error("linearised periods: factorization of K + sigma M failed");
-
-  const int p = static_cast<int>(std::min<Index>(nf, count + 16));
-  std::mt19937 gen(12345);
-  std::uniform_real_distribution<double> dist(-1.0, 1.0);
-  Eigen::MatrixXd X(nf, p);
-  for (Index i = 0; i < X.size(); ++i) X.data()[i] = dist(gen);
-  Eigen::VectorXd lambda, previous;
-  for (int it = 0; it < 200; ++it) {
-    Eigen::MatrixXd Y = Mf * X;
-    X = solver.solve(Y);
-    const Eigen::MatrixXd Kr = X.transpose() * (Kf * X), Mr = X.transpose() * (Mf * X);
-    Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> es(0.5 * (Kr + Kr.transpose()), 0.5 * (Mr + Mr.transpose()));
-    if (es.info() != Eigen::Success) throw std::runtime_error("linearised periods: Rayleigh-Ritz step failed");
-    X = X * es.eigenvectors();
-    lambda = es.eigenvalues();
-    // Converged when the first count+6 Ritz values (rigid modes included) stop changing.
-    const int check = std::min(p, count + 6);
-    if (previous.size() == lambda.size() &&
-        ((lambda.head(check) - previous.head(check)).array().abs() <= 1e-10 * (lambda.head(check).array().abs() + sigma)).all())
-      break;
-    previous = lambda;
-  }
-  std::vector<double> periods;
-  for (int i = 0; i < lambda.size() && static_cast<int>(periods.size()) < count; ++i)
-    if (lambda[i] > 1e-6 * sigma) periods.push_back(2.0 * M_PI / std::sqrt(lambda[i]));
-  return periods;
 }
 
 double measured_period(const std::vector<double>& t, const std::vector<double>& y, double t_from, int* crossings) {

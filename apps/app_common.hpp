@@ -1,7 +1,7 @@
 // What the three benchmark apps (flying_plate, cylindrical_panel, pinched_hemisphere) share, so that
 // each app stays a short tutorial (style.md habit 5): the common command line, input validation before
 // anything is written, locating case files and plot scripts, the run itself (run_dynamic), the plots
-// (scripts/plot_run.py) and a linearised eigen-period estimate.
+// (scripts/plot_run.py) and the measured period of a signal.
 //
 // Errors: every bad input ends in ONE line "<app>: error: <what, where, how to fix>" on stderr and a
 // non-zero exit (1 bad input / failed run, 2 command-line syntax). Inputs are validated before the
@@ -9,12 +9,14 @@
 // leaves run.json with status "incomplete: <reason>" (never "complete") and no plots.
 #pragma once
 
+#include "integrators/runs/executor.hpp"
 #include "lib/case_file.hpp"
 #include "lib/problem.hpp"
 
 #include <CLI/CLI.hpp>
 
 #include <functional>
+#include <memory>
 #include <string>
 #include <utility>
 #include <vector>
@@ -43,6 +45,14 @@ bool run_python_script(const std::string& script, const std::vector<std::string>
 // file, and its nearest existing ancestor must be a writable folder. Creates nothing.
 void check_output_folder(const std::string& dir);
 
+// Where a sweep's runs execute (integrators/runs/executor.hpp), for `shelldyn compare` and other sweep
+// commands: under an MPI launcher (mpirun -n P ..., srun ...) the P ranks (dynamic assignment, rank 0
+// collects; `threads` OpenMP threads per run, 0 → 1, `jobs` ignored); otherwise `jobs` worker threads.
+// Launched by MPI but built without it (SHELLDYN_WITH_MPI=OFF) is an error, since every rank would run
+// the whole sweep into the same folders. Call at most once per process (MPI is initialized here and
+// finalized when the executor is destroyed).
+std::unique_ptr<RunExecutor> make_sweep_executor(int jobs, int threads);
+
 // Throws std::invalid_argument naming the registered integrators if `name` is not one of them.
 void check_integrator_name(const std::string& name);
 
@@ -53,11 +63,6 @@ std::pair<std::string, std::string> split_setting(const std::string& kv, const s
 // e.g. "em-galpha", "galpha_rho_inf=0.8", "em-galpha_dt=0.002". Characters other than
 // [A-Za-z0-9._=+-] are replaced by '-'.
 std::string run_label(const std::string& integrator, const std::vector<std::pair<std::string, std::string>>& overrides);
-
-// Lowest non-rigid linearised eigen-periods 2π/ω of K(q0) φ = ω² M(q0) φ on the free DOFs at the
-// reference state (shift-invert subspace iteration; rigid-body modes, ω² below 1e-6 of the shift,
-// are skipped). Returns up to `count` periods in ascending order of ω.
-std::vector<double> linearised_periods(const Problem& problem, int count);
 
 // Period of a signal y(t) over t >= t_from from its upward crossings of the window mean, with a
 // Schmitt trigger at ±25 % of the half range (ignores higher-mode ripple). Returns 0 when fewer than

@@ -18,6 +18,7 @@
 // add_check_command: it registers its options and, in its callback, stores the action to run.
 // main() stays unchanged apart from one call.
 #include "apps/app_common.hpp"
+#include "apps/modes_command.hpp"
 #include "integrators/runs/compare.hpp"
 #include "integrators/runs/registry.hpp"
 #include "integrators/integrator.hpp"
@@ -289,7 +290,7 @@ struct CompareCommandOptions {
   std::vector<double> dts, rtols;
   double t_end = -1.0, output_every = 0.0;
   int jobs = 2, threads = 0, vtu_every = 0;
-  bool no_plots = false;
+  bool no_plots = false, resume = false;
 };
 
 int run_compare(const CompareCommandOptions& o) {
@@ -314,9 +315,17 @@ int run_compare(const CompareCommandOptions& o) {
   co.out_dir = o.out_dir.empty() ? (fs::path("results") / stem / "compare").string() : o.out_dir;
   const auto runs = expand_compare_runs(co);  // bad specs fail here, before any folder exists
   app::check_output_folder(co.out_dir);
-  std::cout << "shelldyn compare: " << stem << ", " << runs.size() << " runs, " << co.jobs << " at a time -> " << co.out_dir
-            << std::endl;
+  // Where the runs execute: the ranks of an MPI job under mpirun/srun, else --jobs threads (docs/cluster-sweeps.md).
+  const std::unique_ptr<RunExecutor> executor = app::make_sweep_executor(co.jobs, co.threads);
+  co.executor = executor.get();
+  co.resume = o.resume;
+  const bool root = executor->collects();
+  if (!root) co.log = nullptr;
+  if (root)
+    std::cout << "shelldyn compare: " << stem << ", " << runs.size() << " runs on " << executor->describe() << " -> "
+              << co.out_dir << std::endl;
   const CompareResult r = run_comparison(co);
+  if (!root) return 0;  // an MPI worker rank: rank 0 reports
   size_t failed = 0;
   for (const auto& row : r.rows) failed += row.ok ? 0 : 1;
   std::cout << "wrote " << r.summary_csv << ", " << r.summary_md << " (" << r.rows.size() - failed << " complete, " << failed
@@ -332,7 +341,8 @@ void add_compare_command(CLI::App& app, Action& action, const std::string& comma
   std::string names;
   for (const auto& n : integrator_names()) names += (names.empty() ? "" : ", ") + n;
   CLI::App* sub = app.add_subcommand(
-      "compare", "Run one case with several integrator settings (2 at a time); write summary.csv, summary.md and plots");
+      "compare", "Run one case with several integrator settings (2 at a time, or over the ranks of mpirun -n P); write "
+                 "summary.csv, summary.md and plots");
   sub->add_option("case", o->case_path, "Case file (YAML), or a case name of apps/cases such as flying-plate")->required();
   sub->add_option("--integrators", o->specs,
                   "Comma-separated runs NAME[:KEY=VALUE...], e.g. em-galpha,galpha:rho_inf=0.8,em-galpha:dt=2e-3,"
@@ -347,8 +357,12 @@ void add_compare_command(CLI::App& app, Action& action, const std::string& comma
   sub->add_option("--output-every", o->output_every, "Output interval (default: the case's)");
   sub->add_option("--vtu-every", o->vtu_every, "VTU every N output times per run (default 0: none)")->check(CLI::NonNegativeNumber);
   sub->add_option("-o,--output", o->out_dir, "Result folder (default: results/<case>/compare)");
-  sub->add_option("--jobs", o->jobs, "Runs at a time, each single-threaded when > 1 (default 2)");
-  sub->add_option("--threads", o->threads, "OpenMP threads per run when --jobs 1 (default: all cores)")->check(CLI::NonNegativeNumber);
+  sub->add_option("--jobs", o->jobs, "Runs at a time, each single-threaded when > 1 (default 2); under mpirun/srun: one run "
+                                     "per rank at a time, --jobs is ignored");
+  sub->add_option("--threads", o->threads, "OpenMP threads per run when --jobs 1 (default: all cores); under mpirun/srun: per "
+                                           "rank (default 1)")->check(CLI::NonNegativeNumber);
+  sub->add_flag("--resume", o->resume, "Do not rerun runs that an earlier sweep into the same folder finished with the same "
+                                       "settings (their compare-outcome.txt); run only the missing or failed ones");
   sub->add_option("--reference", o->reference, "Label of the reference run for displacement errors (default: finest fixed-step run)");
   sub->add_flag("--no-plots", o->no_plots, "Do not call scripts/plot_compare.py");
   sub->callback([o, &action] { action = [o] { return run_compare(*o); }; });
@@ -368,6 +382,7 @@ int main(int argc, char** argv) {
   add_check_command(app, action, command);
   add_run_command(app, action, command);
   add_static_command(app, action, command);
+  app::add_modes_command(app, action, command);
   add_compare_command(app, action, command);
 
   try {

@@ -180,6 +180,17 @@ class CholmodSolver final : public LinearSolver {
     ++stats_.factorizations;
   }
 
+  // LLᵀ succeeded: positive definite. Simplicial LDLᵀ: D is the diagonal of L (CHOLMOD's LDL' layout).
+  long negative_pivots() const override {
+    if (!factorized_) throw std::logic_error("cholmod: negative_pivots() called without a valid factorization");
+    if (L_->is_ll) return 0;
+    const auto* Lp = static_cast<const Index*>(L_->p);
+    const auto* Lx = static_cast<const double*>(L_->x);
+    long neg = 0;
+    for (size_t j = 0; j < L_->n; ++j) neg += Lx[Lp[j]] < 0.0 ? 1 : 0;
+    return neg;
+  }
+
   void solve(const double* b, double* x) const override {
     profile::Scope prof(profile::Section::solve);
     if (!factorized_) throw std::logic_error("cholmod: solve() called without a valid factorization");
@@ -290,6 +301,11 @@ class EigenLdltSolver final : public LinearSolver {
       throw std::runtime_error("eigen-ldlt: numerical breakdown (non-finite pivot in D)");
     factorized_ = true;
     ++stats_.factorizations;
+  }
+
+  long negative_pivots() const override {
+    if (!factorized_) throw std::logic_error("eigen-ldlt: negative_pivots() called without a valid factorization");
+    return static_cast<long>((ldlt_.vectorD().array() < 0.0).count());
   }
 
   void solve(const double* b, double* x) const override {

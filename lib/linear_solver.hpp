@@ -64,6 +64,12 @@ class LinearSolver {
   // True after a successful factorize() (and until the next analyze() or failed factorize()).
   virtual bool factorized() const = 0;
 
+  // Inertia of the last factorization: the number of negative pivots of A = P L D Lᵀ Pᵀ, which by
+  // Sylvester's law equals the number of negative eigenvalues of A (used for Sturm-sequence counts in
+  // modal analysis and for limit/bifurcation detection in path following). -1 when the back-end
+  // cannot tell (KLU's LU pivots are not an inertia). Requires factorized().
+  virtual long negative_pivots() const { return -1; }
+
   // Counters and process-independent wall times (std::chrono::steady_clock) in seconds.
   struct Stats {
     long analyses = 0, factorizations = 0, solves = 0;

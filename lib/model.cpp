@@ -1,5 +1,6 @@
 #include "lib/model.hpp"
 
+#include "elements/exact_energy.hpp"
 #include "lib/profile.hpp"
 
 #include <algorithm>
@@ -257,12 +258,31 @@ Invariants Model::invariants(const State& s) const {
   Invariants inv;
   std::vector<double> kinetic(elements_.size(), 0.0);
   std::vector<Vec3> L(elements_.size(), Vec3::Zero()), J(elements_.size(), Vec3::Zero());
+  const bool embedded = s.pdot.size() == 3 * static_cast<Index>(mesh_.num_nodes());
+  if (s.pdot.size() != 0 && !embedded)
+    throw std::invalid_argument("Model::invariants: state.pdot has " + std::to_string(s.pdot.size()) +
+                                " entries, expected 3 per node (" + std::to_string(3 * mesh_.num_nodes()) + ")");
   for_each_element(assembler_, [&](int e) {
     CR9Shell::Vec45 ue, ve;
     gather(e, s.u, ue);
     gather(e, s.v, ve);
     const auto ch = element_charts(e, s.charts);
     const auto& el = elements_[static_cast<size_t>(e)];
+    if (embedded) {  // em-exact: K, L, J from the embedded director velocities (state.hpp, theory §2)
+      NodeVectors x, p, v, w;
+      const auto& nodes = mesh_.elements[static_cast<size_t>(e)];
+      for (size_t a = 0; a < 9; ++a) {
+        const int i = nodes[a];
+        x[a] = mesh_.X[static_cast<size_t>(i)] + ue.segment<3>(5 * static_cast<Index>(a));
+        p[a] = shelldyn::director(ue.segment<2>(5 * static_cast<Index>(a) + 3), ch[a]);
+        v[a] = ve.segment<3>(5 * static_cast<Index>(a));
+        w[a] = s.pdot.segment<3>(3 * static_cast<Index>(i));
+      }
+      const double rh = material_.rho * material_.thickness, rh3 = rh * material_.thickness * material_.thickness / 12.0;
+      kinetic[static_cast<size_t>(e)] = embedded_kinetic(el.scalar_mass(), rh, rh3, v, w);
+      embedded_momenta(el.scalar_mass(), rh, rh3, x, p, v, w, &L[static_cast<size_t>(e)], &J[static_cast<size_t>(e)]);
+      return;
+    }
     kinetic[static_cast<size_t>(e)] = el.kinetic(ue, ve, ch);
     el.momenta(ue, ve, ch, &L[static_cast<size_t>(e)], &J[static_cast<size_t>(e)]);
   });
@@ -309,6 +329,132 @@ int Model::rechart(State& s, double hysteresis) {
   }
   if (switched) dofs_.resolve(s.charts);
   return switched;
+}
+
+// ---- em-exact (docs/theory/exact-energy-momentum.md) ------------------------------------------------------
+
+void Model::scalar_mass_times(const Eigen::VectorXd& x, Eigen::VectorXd& y) const {
+  const Index n3 = 3 * static_cast<Index>(mesh_.num_nodes());
+  if (x.size() != n3) throw std::invalid_argument("Model::scalar_mass_times: x needs 3 entries per node");
+  y.setZero(n3);
+  for_each_element(assembler_, [&](int e) {  // colours: no two elements of a colour share a node
+    const auto& nodes = mesh_.elements[static_cast<size_t>(e)];
+    const auto& m = elements_[static_cast<size_t>(e)].scalar_mass();
+    for (size_t a = 0; a < 9; ++a) {
+      Vec3 s = Vec3::Zero();
+      for (size_t b = 0; b < 9; ++b) s += m(static_cast<Index>(a), static_cast<Index>(b)) * x.segment<3>(3 * static_cast<Index>(nodes[b]));
+      y.segment<3>(3 * static_cast<Index>(nodes[a])) += s;
+    }
+  });
+}
+
+void Model::element_energies(const Eigen::VectorXd& u, const std::vector<DirectorChart>& charts,
+                             std::vector<double>& U) const {
+  U.assign(elements_.size(), 0.0);
+  for_each_element(assembler_, [&](int e) {
+    CR9Shell::Vec45 ue;
+    gather(e, u, ue);
+    U[static_cast<size_t>(e)] = elements_[static_cast<size_t>(e)].internal(ue, element_charts(e, charts), nullptr, nullptr);
+  });
+}
+
+CR9Shell::Mat45 Model::reference_local_stiffness(int e) const {
+  const auto& nodes = mesh_.elements[static_cast<size_t>(e)];
+  CR9Shell::Charts ch;
+  CR9Shell::Vec45 u = CR9Shell::Vec45::Zero();
+  for (size_t a = 0; a < 9; ++a) {
+    const Vec3& p0 = normals_[static_cast<size_t>(nodes[a])];
+    ch[a] = select_chart(p0);
+    u.segment<2>(5 * static_cast<Index>(a) + 3) = chart_coordinates(p0, ch[a]);
+  }
+  CR9Shell::Mat45 kL;
+  elements_[static_cast<size_t>(e)].local(u, ch, nullptr, nullptr, &kL);
+  return kL;
+}
+
+double Model::exact_internal(const Eigen::VectorXd& u_n, const Eigen::VectorXd& u_np1,
+                             const std::vector<DirectorChart>& charts, const std::vector<double>& U_n, bool correct,
+                             double xi, const std::vector<CR9Shell::Mat45>* k0, double* F, SparseMatrix* K,
+                             std::vector<double>* U_np1, ExactForceInfo* info) const {
+  if (U_n.size() != elements_.size()) throw std::invalid_argument("Model::exact_internal: U_n needs one entry per element");
+  if (xi > 0.0 && (!k0 || k0->size() != elements_.size()))
+    throw std::invalid_argument("Model::exact_internal: xi > 0 needs the reference local stiffness of every element");
+  if (F) std::fill(F, F + num_dofs(), 0.0);
+  if (K) K->set_zero();
+  std::vector<double> energy(elements_.size(), 0.0), beta_z(elements_.size(), 0.0), diss(elements_.size(), 0.0);
+  std::vector<char> guard(elements_.size(), 0);
+  for_each_element(assembler_, [&](int e) {
+    const auto& el = elements_[static_cast<size_t>(e)];
+    const auto ch = element_charts(e, charts);
+    CR9Shell::Vec45 un, u1, fe;
+    CR9Shell::Mat45 ke;
+    gather(e, u_n, un);
+    gather(e, u_np1, u1);
+    // Paper force F = T(u_mid)ᵀ f*_L (§6.3 at α_f = ½, ξ = 0) and its symmetric tangent K_mid.
+    const double U1 = el.algorithmic_internal(un, u1, ch, 0.5, 0.0, &fe, K ? &ke : nullptr);
+    energy[static_cast<size_t>(e)] = U1;
+    const CR9Shell::Vec45 du = u1 - un;
+    RigidRows R;
+    if (correct || xi > 0.0) {
+      NodeVectors xm, pm;
+      const auto& nodes = mesh_.elements[static_cast<size_t>(e)];
+      for (size_t a = 0; a < 9; ++a) {
+        const Index k = 5 * static_cast<Index>(a);
+        xm[a] = mesh_.X[static_cast<size_t>(nodes[a])] + 0.5 * (un.segment<3>(k) + u1.segment<3>(k));
+        pm[a] = 0.5 * (shelldyn::director(un.segment<2>(k + 3), ch[a]) + shelldyn::director(u1.segment<2>(k + 3), ch[a]));
+      }
+      R = midpoint_rigid_rows(xm, pm, ch);
+    }
+    if (correct) {  // theory §3: R F* = 0, Δuᵀ F* = ΔU
+      const double fmax = fe.cwiseAbs().maxCoeff();
+      const CorrectionInfo ci = energy_momentum_correction(R, du, U1 - U_n[static_cast<size_t>(e)], fe);
+      guard[static_cast<size_t>(e)] = ci.rigid_guard;
+      if (fmax > 0.0) beta_z[static_cast<size_t>(e)] = std::abs(ci.beta) * std::sqrt(ci.z_norm2) / fmax;
+    }
+    if (xi > 0.0) {  // theory §6: ξ G Δu with G = Π Tᵀ k0 T Π (PSD, G Rᵀ = 0)
+      const CR9Shell::Vec45 um = 0.5 * (un + u1);
+      const CR9Shell::Mat45 T = el.frame(um, ch).matrix();
+      const CR9Shell::Mat45 P = rigid_complement_projector(R);
+      const CR9Shell::Mat45 TP = T * P;
+      const CR9Shell::Mat45 G = TP.transpose() * (*k0)[static_cast<size_t>(e)] * TP;
+      const CR9Shell::Vec45 fd = xi * (G * du);
+      fe += fd;
+      diss[static_cast<size_t>(e)] = du.dot(fd);
+      if (K) ke += (2.0 * xi) * G;
+    }
+    if (F) assembler_.add_vector(e, fe, F);
+    if (K) assembler_.add_matrix(e, ke, K->values.data());
+  });
+  if (U_np1) *U_np1 = energy;
+  if (info) {
+    *info = ExactForceInfo{};
+    for (size_t e = 0; e < elements_.size(); ++e) {
+      info->rigid_guards += guard[e];
+      info->max_beta_z = std::max(info->max_beta_z, beta_z[e]);
+    }
+    info->dissipation = sum(diss);
+  }
+  return sum(energy);
+}
+
+void Model::embedded_external(double t, const Eigen::VectorXd& p_mid, Eigen::VectorXd& Fd, Eigen::VectorXd& g) const {
+  const Index n3 = 3 * static_cast<Index>(mesh_.num_nodes());
+  Fd.setZero(n3);
+  g.setZero(n3);
+  for (const auto& load : loads_) {
+    const double f = load.function(t);
+    if (f == 0.0) continue;
+    const Index k = 3 * static_cast<Index>(load.node);
+    if (load.kind == NodalLoad::Kind::Force) {
+      Fd.segment<3>(k) += f * load.vector;
+    } else if (load.kind == NodalLoad::Kind::Moment) {
+      // Dead moment m: its work on a director increment Δp is (m × p_mid)·Δp (theory §4).
+      g.segment<3>(k) += (f * load.vector).cross(Vec3(p_mid.segment<3>(k)));
+    } else {
+      throw std::invalid_argument("Model::embedded_external: load kind not supported by em-exact (node " +
+                                  std::to_string(load.node) + ")");
+    }
+  }
 }
 
 }  // namespace shelldyn

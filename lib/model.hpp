@@ -82,6 +82,33 @@ class Model final : public SemiDiscreteSystem {
   Invariants invariants(const State& s) const override;
   double loads_end() const override;
 
+  // ---- Embedded kinematics of the exactly conserving step em-exact (docs/theory/exact-energy-momentum.md) ----
+  // y = (m ⊗ I₃) x: x, y hold one 3-vector per node; m = Σ_e ∫ N_i N_j dA (consistent scalar mass).
+  void scalar_mass_times(const Eigen::VectorXd& x, Eigen::VectorXd& y) const;
+  // Strain energy U_e(u) of every element (U.size() = number of elements).
+  void element_energies(const Eigen::VectorXd& u, const std::vector<DirectorChart>& charts, std::vector<double>& U) const;
+  // Linear local stiffness k_L at the stress-free reference state of element e (symmetric PSD, zero on rigid modes).
+  CR9Shell::Mat45 reference_local_stiffness(int e) const;
+  struct ExactForceInfo {
+    int rigid_guards = 0;     // elements whose step was rigid (β = 0)
+    double max_beta_z = 0.0;  // max over elements of ‖β z‖∞ / ‖F‖∞ (size of the energy correction)
+    double dissipation = 0.0; // Σ_e ξ Δuᵀ G_e Δu ≥ 0 removed by the dissipative force
+  };
+  // The internal force of em-exact (theory §§3, 5): per element the strain-averaged midpoint force
+  // (algorithmic_internal with α_f = ½, ξ = 0) corrected to F* = F + Rᵀa + βz (elements/exact_energy.hpp) so
+  // that R F* = 0 and Δuᵀ F* = U_e(u_np1) − U_n[e]; `correct` = false skips the correction (tests only).
+  // With xi > 0, adds the dissipative force ξ G_e Δu, G_e = Π Tᵀ k0_e T Π (T at u_mid, Π the rigid-complement
+  // projector, k0 = (*k0)[e]). K (optional): the symmetric tangent with respect to u_mid (K_mid of
+  // algorithmic_internal, plus 2ξ G_e so that ½K is its derivative with respect to u_np1).
+  // U_np1 (optional) receives the element energies at u_np1. Returns V(u_np1).
+  double exact_internal(const Eigen::VectorXd& u_n, const Eigen::VectorXd& u_np1, const std::vector<DirectorChart>& charts,
+                        const std::vector<double>& U_n, bool correct, double xi,
+                        const std::vector<CR9Shell::Mat45>* k0, double* F, SparseMatrix* K,
+                        std::vector<double>* U_np1, ExactForceInfo* info) const;
+  // Dead loads at time t in embedded form: translational forces Fd and director loads g_i = m_i × p_mid,i
+  // (3 per node each, overwritten); p_mid holds one 3-vector per node.
+  void embedded_external(double t, const Eigen::VectorXd& p_mid, Eigen::VectorXd& Fd, Eigen::VectorXd& g) const;
+
   // Current director of node i.
   Vec3 director(const State& s, int node) const;
 

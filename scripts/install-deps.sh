@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
 # Installs shelldyn's build and test dependencies from Debian 12's packages (run as root).
 # Idempotent: does nothing (not even `apt-get update`) when every package is already installed.
+#   bash scripts/install-deps.sh              # what the default build and tests need
+#   bash scripts/install-deps.sh --with-mpi   # also Open MPI: MPI-distributed sweeps (docs/cluster-sweeps.md)
 set -euo pipefail
 
 PACKAGES=(
@@ -10,11 +12,16 @@ PACKAGES=(
   libopenblas0-pthread                 # fast BLAS for CHOLMOD's supernodal factorization
   libeigen3-dev                        # Eigen 3.4
   libyaml-cpp-dev libcli11-dev         # case files, command line
+  libspectra-dev                       # Spectra: shift-invert Lanczos of `shelldyn modes` (header-only)
   libgtest-dev libgmock-dev            # unit tests
   libbenchmark-dev                     # performance programs
   python3 python3-meshio               # VTU round-trip check in the test suite
   python3-matplotlib                   # plots of the apps and `shelldyn compare` (scripts/plot_*.py)
 )
+
+if [ "${1:-}" = "--with-mpi" ]; then
+  PACKAGES+=(libopenmpi-dev openmpi-bin)   # optional: SHELLDYN_WITH_MPI, `mpirun -n P shelldyn compare`
+fi
 
 missing=()
 for p in "${PACKAGES[@]}"; do

@@ -1,4 +1,5 @@
 #include "integrators/runs/compare.hpp"
+#include "integrators/runs/executor.hpp"
 #include "integrators/runs/registry.hpp"
 
 #include "integrators/integrator.hpp"
@@ -6,6 +7,7 @@
 #include "lib/case_file.hpp"
 #include "lib/history_writer.hpp"
 #include "lib/problem.hpp"
+#include "lib/run_info.hpp"
 
 #include <algorithm>
 #include <atomic>
@@ -14,6 +16,8 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
+#include <memory>
 #include <map>
 #include <mutex>
 #include <set>
@@ -258,69 +262,113 @@ std::vector<CompareRun> expand_compare_runs(const CompareOptions& o) {
   return runs;
 }
 
-CompareResult run_comparison(const CompareOptions& o) {
-  if (o.out_dir.empty()) throw std::invalid_argument("compare: an output folder is required");
-  const std::vector<CompareRun> runs = expand_compare_runs(o);
-  Problem first = load_problem(o.case_path);  // validates the case once, up front
-  const double loads_end = first.model->loads_end();
-  const double t_end = o.t_end >= 0.0 ? o.t_end : first.spec.time.t_end;
-  CompareResult result;
-  for (const auto& m : first.disc.monitors) result.monitors.push_back(m.name);
-  std::error_code ec;
-  fs::create_directories(o.out_dir, ec);
-  if (ec) throw std::runtime_error("cannot create the comparison folder '" + o.out_dir + "': " + ec.message());
+namespace {
 
-  result.rows.resize(runs.size());
-  std::mutex log_mutex;
-  auto say = [&](const std::string& line) {
-    if (!o.log) return;
-    std::lock_guard<std::mutex> lock(log_mutex);
-    *o.log << line << std::endl;
-  };
-  std::atomic<size_t> next{0};
-  const int jobs = std::max(1, std::min<int>(o.jobs, static_cast<int>(runs.size())));
-  auto worker = [&]() {
-    for (size_t k = next++; k < runs.size(); k = next++) {
-      CompareRow& row = result.rows[k];
-      row.run = runs[k];
-      row.out_dir = (fs::path(o.out_dir) / runs[k].label).string();
-      const std::string tag = "[" + std::to_string(k + 1) + "/" + std::to_string(runs.size()) + "] " + runs[k].label;
-      say(tag + ": started -> " + row.out_dir);
-      try {
-        fs::create_directories(row.out_dir);
-        std::ofstream log(row.out_dir + "/log.txt");
-        Problem problem = load_problem(o.case_path);
-        RunOptions ro;
-        ro.out_dir = row.out_dir;
-        ro.integrator = runs[k].integrator;
-        ro.settings = runs[k].inherited;
-        ro.settings.insert(ro.settings.end(), runs[k].overrides.begin(), runs[k].overrides.end());
-        ro.dt = runs[k].dt;
-        ro.t_end = o.t_end;
-        ro.output_interval = o.output_interval;
-        ro.vtu_every = o.vtu_every;
-        ro.threads = jobs > 1 ? 1 : o.threads;
-        ro.log = &log;
-        ro.command = o.command + "  [run " + runs[k].label + "]";
-        ro.label = runs[k].label;
-        row.summary = run_dynamic(problem, ro);
-        print_run_summary(log, row.summary);
-        row.ok = true;
-        row.status = "complete";
-        if (t_end >= loads_end) row.energy_error = mechanical_energy_drift(read_csv_table(row.out_dir + "/history.csv"), loads_end);
-        say(tag + ": complete, " + std::to_string(row.summary.totals.steps) + " steps, " + num(row.summary.wall_seconds) +
-            " s, energy error " + num(row.energy_error));
-      } catch (const std::exception& e) {
-        row.ok = false;
-        row.status = "failed: " + one_line(e.what());
-        say(tag + ": " + row.status);
-      }
+// --- one run's result as text: what a worker (thread or MPI rank) sends back, and what --resume reads --------
+// "key value" lines; numbers with 17 significant digits (exact round trip), so a summary assembled from
+// payloads is identical to one assembled in-process.
+std::string encode_outcome(const RunSummary& s, double energy_error) {
+  std::ostringstream os;
+  os << "integrator " << s.integrator << "\nstatus " << one_line(s.status) << "\n";
+  for (const auto& [k, v] : s.settings) os << "setting " << k << "=" << one_line(v) << "\n";
+  const StepReport& t = s.totals;
+  os << "totals " << t.steps << " " << t.rejected_steps << " " << t.nonlinear_iterations << " " << t.linear_setups << " "
+     << t.factorizations << " " << t.rhs_evaluations << " " << t.chart_switches << " " << t.root_events << " "
+     << t.reinitializations << " " << full(t.residual_norm) << " " << full(t.energy_ratio) << " " << full(t.last_dt) << " "
+     << full(t.wall_seconds) << "\n";
+  os << "values " << full(s.t_end) << " " << full(s.H0) << " " << full(s.H_ref) << " " << full(s.E_ref) << " " << full(s.t_ref)
+     << " " << full(s.H_final) << " " << full(s.max_rel_drift) << " " << full(s.final_rel_drift) << " " << full(s.max_dL) << " "
+     << full(s.max_dJ) << " " << full(s.ref_L) << " " << full(s.ref_J) << " " << full(s.max_strain_ratio) << " "
+     << full(s.wall_seconds) << " " << full(energy_error) << "\n";
+  for (const auto& [name, v] : s.final_monitors) os << "monitor " << full(v) << " " << name << "\n";
+  os << "end\n";
+  return os.str();
+}
+
+double read_number(std::istream& in) {
+  std::string w;
+  in >> w;
+  char* end = nullptr;
+  const double x = std::strtod(w.c_str(), &end);
+  if (w.empty() || *end != '\0') throw std::runtime_error("bad number '" + w + "'");
+  return x;
+}
+
+void decode_outcome(const std::string& text, RunSummary& s, double& energy_error) {
+  std::istringstream in(text);
+  bool ended = false;
+  for (std::string line; std::getline(in, line);) {
+    const auto sp = line.find(' ');
+    const std::string key = line.substr(0, sp), rest = sp == std::string::npos ? "" : line.substr(sp + 1);
+    std::istringstream ls(rest);
+    if (key == "integrator") {
+      s.integrator = rest;
+    } else if (key == "status") {
+      s.status = rest;
+    } else if (key == "setting") {
+      const auto eq = rest.find('=');
+      s.settings.emplace_back(rest.substr(0, eq), eq == std::string::npos ? "" : rest.substr(eq + 1));
+    } else if (key == "totals") {
+      StepReport& t = s.totals;
+      for (long* p : {&t.steps, &t.rejected_steps, &t.nonlinear_iterations, &t.linear_setups, &t.factorizations,
+                      &t.rhs_evaluations, &t.chart_switches, &t.root_events, &t.reinitializations})
+        *p = static_cast<long>(read_number(ls));
+      for (double* p : {&t.residual_norm, &t.energy_ratio, &t.last_dt, &t.wall_seconds}) *p = read_number(ls);
+    } else if (key == "values") {
+      for (double* p : {&s.t_end, &s.H0, &s.H_ref, &s.E_ref, &s.t_ref, &s.H_final, &s.max_rel_drift, &s.final_rel_drift,
+                        &s.max_dL, &s.max_dJ, &s.ref_L, &s.ref_J, &s.max_strain_ratio, &s.wall_seconds, &energy_error})
+        *p = read_number(ls);
+    } else if (key == "monitor") {
+      const double v = read_number(ls);
+      std::string name;
+      std::getline(ls >> std::ws, name);
+      s.final_monitors.emplace_back(name, v);
+    } else if (key == "end") {
+      ended = true;
+    } else if (!key.empty()) {
+      throw std::runtime_error("unknown key '" + key + "'");
     }
-  };
-  std::vector<std::thread> pool;
-  for (int j = 0; j < jobs; ++j) pool.emplace_back(worker);
-  for (auto& t : pool) t.join();
+  }
+  if (!ended) throw std::runtime_error("truncated (no 'end' line)");
+}
 
+uint64_t fnv1a(const std::string& bytes, uint64_t h = 1469598103934665603ull) {
+  for (unsigned char c : bytes) h = (h ^ c) * 1099511628211ull;
+  return h;
+}
+
+// What must match for --resume to reuse a finished run: the case file's bytes, the program version and
+// every setting that shapes the run's results.
+std::string run_fingerprint(const CompareOptions& o, const CompareRun& r, const std::string& case_bytes) {
+  std::ostringstream os;
+  os << "shelldyn " << shelldyn_version() << "; case " << std::hex << fnv1a(case_bytes) << std::dec << "; " << r.integrator
+     << "; " << settings_text(r.inherited, ",") << "; " << settings_text(r.overrides, ",") << "; dt " << full(r.dt) << "; t_end "
+     << full(o.t_end) << "; output " << full(o.output_interval) << "; vtu " << o.vtu_every;
+  return one_line(os.str());
+}
+
+constexpr const char* kOutcomeFile = "compare-outcome.txt";
+constexpr const char* kNotFinished = "failed: not finished (the sweep is still running, or was stopped before this run ended)";
+
+// Expected cost in steps (runs start longest first): t_end/dt for fixed-step runs; for adaptive runs
+// 10x the case's step count, times (1e-6/rtol)^(1/4) — a rough fit of the SUNDIALS baselines'
+// step counts in the README (about 1e4–1e5 steps per simulated second against 50–1000 fixed steps).
+double expected_cost(const CompareRun& r, double t_end, double case_dt) {
+  const double steps = t_end / (r.dt > 0.0 ? r.dt : case_dt);
+  if (!r.adaptive) return steps;
+  double rtol = 1e-6;
+  for (const auto& [k, v] : r.overrides)
+    if (k == "rtol") rtol = std::strtod(v.c_str(), nullptr);
+  return 10.0 * steps * std::pow(1e-6 / std::max(rtol, 1e-300), 0.25);
+}
+
+}  // namespace
+
+namespace {
+
+// summary.csv and summary.md from the rows as they are now (unfinished rows included).
+void write_compare_summaries(const CompareOptions& o, const Problem& first, double loads_end, double t_end,
+                             CompareResult& result, std::map<std::string, CsvTable>& histories) {
   // --- reference run and displacement errors ------------------------------------------------------------
   const CompareRow* ref = nullptr;
   if (!o.reference.empty()) {
@@ -337,26 +385,34 @@ CompareResult run_comparison(const CompareOptions& o) {
       for (const auto& r : result.rows)
         if (r.ok && (!ref || r.summary.totals.steps > ref->summary.totals.steps)) ref = &r;
   }
+  result.reference.clear();
+  for (auto& r : result.rows) r.displacement_error = std::nan("");
+  // histories of finished runs, read once per run (a summary is rewritten after every run)
+  auto history = [&](const CompareRow& r) -> const CsvTable& {
+    auto it = histories.find(r.run.label);
+    if (it == histories.end()) it = histories.emplace(r.run.label, read_csv_table(r.out_dir + "/history.csv")).first;
+    return it->second;
+  };
   if (ref) {
     result.reference = ref->run.label;
     try {
-      const CsvTable ref_table = read_csv_table(ref->out_dir + "/history.csv");
+      const CsvTable& ref_table = history(*ref);
       for (auto& r : result.rows) {
         if (!r.ok) continue;
         try {
-          r.displacement_error = monitor_distance(read_csv_table(r.out_dir + "/history.csv"), ref_table, result.monitors);
+          r.displacement_error = monitor_distance(history(r), ref_table, result.monitors);
         } catch (const std::exception&) {
         }
       }
     } catch (const std::exception& e) {
-      say("warning: no displacement errors: " + one_line(e.what()));
+      if (o.log) *o.log << "warning: no displacement errors: " << one_line(e.what()) << std::endl;
     }
   }
 
   // --- summary.csv ---------------------------------------------------------------------------------------
   result.summary_csv = (fs::path(o.out_dir) / "summary.csv").string();
   {
-    std::ofstream csv(result.summary_csv);
+    std::ofstream csv(result.summary_csv + ".tmp");  // then renamed: a reader never sees half a file
     if (!csv) throw std::runtime_error(result.summary_csv + ": cannot write");
     csv << "label,integrator,overrides,settings,dt,t_end,steps,rejected_steps,nonlinear_iterations,linear_setups,"
            "factorizations,rhs_evaluations,chart_switches,wall_s,t_ref,energy_error,max_rel_drift_of_H,"
@@ -387,13 +443,15 @@ CompareResult run_comparison(const CompareOptions& o) {
       }
       csv << "," << full(r.displacement_error) << "," << csv_field(result.reference) << "," << csv_field(r.status) << "\n";
     }
+    csv.close();
     if (!csv) throw std::runtime_error(result.summary_csv + ": write error");
+    fs::rename(result.summary_csv + ".tmp", result.summary_csv);
   }
 
   // --- summary.md ----------------------------------------------------------------------------------------
   result.summary_md = (fs::path(o.out_dir) / "summary.md").string();
   {
-    std::ofstream md(result.summary_md);
+    std::ofstream md(result.summary_md + ".tmp");
     if (!md) throw std::runtime_error(result.summary_md + ": cannot write");
     const std::string mon = result.monitors.empty() ? std::string() : result.monitors.front();
     md << "# Integrator comparison: " << first.spec.name << "\n\n";
@@ -429,9 +487,130 @@ CompareResult run_comparison(const CompareOptions& o) {
         md << "– | – | – | – | – | – | – | – | – | " << md_cell(r.status) << " |\n";
       }
     }
+    md.close();
     if (!md) throw std::runtime_error(result.summary_md + ": write error");
+    fs::rename(result.summary_md + ".tmp", result.summary_md);
   }
+}
+
+}  // namespace
+
+CompareResult run_comparison(const CompareOptions& o) {
+  if (o.out_dir.empty()) throw std::invalid_argument("compare: an output folder is required");
+  const std::vector<CompareRun> runs = expand_compare_runs(o);
+  Problem first = load_problem(o.case_path);  // validates the case once, up front
+  const double loads_end = first.model->loads_end();
+  const double t_end = o.t_end >= 0.0 ? o.t_end : first.spec.time.t_end;
+  CompareResult result;
+  for (const auto& m : first.disc.monitors) result.monitors.push_back(m.name);
+  std::error_code ec;
+  fs::create_directories(o.out_dir, ec);
+  if (ec) throw std::runtime_error("cannot create the comparison folder '" + o.out_dir + "': " + ec.message());
+  std::string case_bytes;
+  {
+    std::ifstream in(o.case_path, std::ios::binary);
+    case_bytes.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  }
+
+  result.rows.resize(runs.size());
+  std::vector<RunJob> jobs;
+  for (size_t k = 0; k < runs.size(); ++k) {
+    CompareRow& row = result.rows[k];
+    row.run = runs[k];
+    row.out_dir = (fs::path(o.out_dir) / runs[k].label).string();
+    row.status = kNotFinished;
+    jobs.push_back({runs[k].label, expected_cost(runs[k], t_end, first.spec.time.dt)});
+  }
+  std::unique_ptr<RunExecutor> own;
+  if (!o.executor) own = make_local_executor(o.jobs, o.threads);
+  RunExecutor& executor = o.executor ? *o.executor : *own;
+  std::ostream* log = executor.collects() ? o.log : nullptr;
+
+  // One run, on whichever thread or rank the executor chose: its own Problem, its own folder.
+  const RunFunction run_one = [&](size_t k, int threads) -> std::string {
+    const CompareRun& run = runs[k];
+    const std::string dir = (fs::path(o.out_dir) / run.label).string();
+    const std::string fingerprint = run_fingerprint(o, run, case_bytes);
+    if (o.resume) {  // a finished run of the same settings: reuse its outcome
+      std::ifstream in(dir + "/" + kOutcomeFile);
+      std::string head, body;
+      if (in && std::getline(in, head) && head == "fingerprint " + fingerprint) {
+        body.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+        RunSummary s;
+        double e = 0.0;
+        try {
+          decode_outcome(body, s, e);
+          if (s.status == "complete") return "reused\n" + body;
+        } catch (const std::exception&) {
+        }
+      }
+    }
+    fs::remove(dir + "/" + kOutcomeFile);
+    fs::create_directories(dir);
+    std::ofstream runlog(dir + "/log.txt");
+    Problem problem = load_problem(o.case_path);
+    RunOptions ro;
+    ro.out_dir = dir;
+    ro.integrator = run.integrator;
+    ro.settings = run.inherited;
+    ro.settings.insert(ro.settings.end(), run.overrides.begin(), run.overrides.end());
+    ro.dt = run.dt;
+    ro.t_end = o.t_end;
+    ro.output_interval = o.output_interval;
+    ro.vtu_every = o.vtu_every;
+    ro.threads = threads;
+    ro.log = &runlog;
+    ro.command = o.command + "  [run " + run.label + "]";
+    ro.label = run.label;
+    const RunSummary summary = run_dynamic(problem, ro);
+    print_run_summary(runlog, summary);
+    const double energy_error =
+        t_end >= loads_end ? mechanical_energy_drift(read_csv_table(dir + "/history.csv"), loads_end) : std::nan("");
+    const std::string payload = encode_outcome(summary, energy_error);
+    {  // written last: its presence means the run finished (for --resume)
+      const std::string tmp = dir + "/" + kOutcomeFile + ".tmp";
+      std::ofstream out(tmp);
+      out << "fingerprint " << fingerprint << "\n" << payload;
+      out.close();
+      if (out) fs::rename(tmp, dir + "/" + kOutcomeFile);
+    }
+    return payload;
+  };
+
+  // On the collecting process: fill the row, rewrite the summary (every row, unfinished ones marked), so
+  // that a sweep stopped at any point leaves a summary that lists every run.
+  std::map<std::string, CsvTable> histories;
+  const OutcomeCallback on_outcome = [&](size_t k, const RunOutcome& outcome, bool more) {
+    CompareRow& row = result.rows[k];
+    row.ok = outcome.ok;
+    row.status = outcome.status;
+    row.summary = RunSummary{};
+    row.energy_error = std::nan("");
+    histories.erase(row.run.label);
+    if (outcome.ok) {
+      std::string payload = outcome.payload;
+      const bool reused = payload.rfind("reused\n", 0) == 0;
+      if (reused) payload = payload.substr(7);
+      try {
+        decode_outcome(payload, row.summary, row.energy_error);
+        if (log)
+          *log << "[" << k + 1 << "/" << runs.size() << "] " << row.run.label << ": " << row.summary.totals.steps << " steps, "
+               << num(row.summary.wall_seconds) << " s, energy error " << num(row.energy_error)
+               << (reused ? " (reused: --resume found it finished with the same settings)" : "") << std::endl;
+      } catch (const std::exception& e) {
+        row.ok = false;
+        row.status = "failed: unreadable result (" + one_line(e.what()) + ")";
+      }
+    }
+    if (!more) write_compare_summaries(o, first, loads_end, t_end, result, histories);
+  };
+
+  if (executor.collects()) write_compare_summaries(o, first, loads_end, t_end, result, histories);
+  execute_runs(jobs, run_one, executor, on_outcome, log);
+  if (!executor.collects()) return result;
+  write_compare_summaries(o, first, loads_end, t_end, result, histories);
   return result;
 }
+
 
 }  // namespace shelldyn

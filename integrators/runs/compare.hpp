@@ -17,9 +17,19 @@
 // runs differ only in their integrator and what their spec says; spec overrides win. They are recorded
 // in run.json and summary.csv (`settings`), not in the labels.
 //
-// Execution: `jobs` runs at a time in worker threads, each with its own Problem (case loaded anew) and
-// OpenMP threads = 1 when jobs > 1. Each run writes DIR/<label>/{history.csv,run.json,log.txt[,fields]}.
-// A run that throws is a row with status "failed: <reason>", never dropped.
+// Execution (integrators/runs/executor.hpp): `executor` if given — e.g. the ranks of an MPI job,
+// integrators/runs/mpi_executor.hpp — else `jobs` worker threads of this process (OpenMP threads = 1 per
+// run when jobs > 1). Runs start longest expected first (t_end/dt steps; adaptive runs weighted, see
+// expected_cost in compare.cpp). Each run has its own Problem (case loaded anew) and writes
+// DIR/<label>/{history.csv,run.json,log.txt[,fields]} and, once finished, compare-outcome.txt (its
+// summary figures and a fingerprint of its settings). A run that throws is a row with status
+// "failed: <reason>", never dropped.
+// Summaries are rewritten after every finished run, with the runs not finished yet as rows "failed: not
+// finished (...)", so a sweep stopped at any point (killed, time limit) leaves a summary of every run.
+// resume = true: a run whose folder holds a compare-outcome.txt with the same fingerprint (case file
+// bytes, shelldyn version, integrator, settings, dt, t_end, output interval, vtu) is not run again; its
+// recorded outcome is used.
+// Under MPI only the collecting rank (rank 0) writes summaries; the others return rows without results.
 //
 // Results: DIR/summary.csv (one row per run, machine-readable) and DIR/summary.md (the same as a table
 // with the command, the case and the reference run). The displacement error of a run is
@@ -33,6 +43,7 @@
 // unreadable case throw std::invalid_argument / std::runtime_error before any run starts.
 #pragma once
 
+#include "integrators/runs/executor.hpp"
 #include "integrators/runs/run_driver.hpp"
 
 #include <limits>
@@ -53,6 +64,8 @@ struct CompareOptions {
   int vtu_every = 0;                // VTU output per run: 0 none (default), < 0 the case's
   int jobs = 2;                     // runs at a time
   int threads = 0;                  // OpenMP threads per run when jobs == 1 (0: default)
+  RunExecutor* executor = nullptr;  // where runs execute (null: a local pool of `jobs` threads)
+  bool resume = false;              // reuse finished runs of an earlier sweep (see above)
   std::string out_dir;              // required
   std::string reference;            // label of the reference run (empty: automatic, see above)
   std::ostream* log = nullptr;      // one line per run start/finish
@@ -93,7 +106,7 @@ CompareRun parse_compare_spec(const std::string& spec);
 std::vector<CompareRun> expand_compare_runs(const CompareOptions& options);
 
 // Runs the study and writes summary.csv / summary.md. Throws only for bad options or when the summary
-// cannot be written; failed runs are rows.
+// cannot be written; failed runs are rows. On a non-collecting MPI rank the summary paths are empty.
 CompareResult run_comparison(const CompareOptions& options);
 
 // history.csv (or any numeric CSV with a header row) as columns; "nan" parses as NaN.

@@ -2,6 +2,7 @@
 
 #include "integrators/baselines/arkode_integrators.hpp"
 #include "integrators/baselines/ida_bdf.hpp"
+#include "integrators/newmark/em_exact.hpp"
 #include "integrators/newmark/em_generalized_alpha.hpp"
 
 #include <map>
@@ -16,6 +17,7 @@ struct Entry {
 const std::map<std::string, Entry>& registry() {
   static const std::map<std::string, Entry> r = {
       {"em-galpha", {make_em_galpha, "energy-momentum generalized-alpha of Li & Qian (2025): strain-averaged internal force"}},
+      {"em-exact", {make_em_exact, "exactly energy-momentum conserving step: embedded director velocities, corrected element forces (docs/theory/exact-energy-momentum.md)"}},
       {"galpha", {make_galpha, "Chung-Hulbert generalized-alpha: alpha_f-weighted end-point internal forces"}},
       {"midpoint", {make_midpoint, "generalized midpoint: internal force at the midpoint configuration (no strain averaging)"}},
       {"newmark", {make_newmark, "Newmark (beta, gamma): forces at t_{n+1}"}},

@@ -1,0 +1,61 @@
+// Element-level pieces of the exactly energy–momentum conserving step `em-exact`
+// (docs/theory/exact-energy-momentum.md; notation of the CR9 element, DOFs [d_i, q_i] node-major).
+//
+// 1. Rigid rows R (6×45) at the step's midpoint configuration x_mid,i = X_i + (d_n + d_{n+1})/2,
+//    p_mid,i = (p_n + p_{n+1})/2 (p_mid is not unit): three translations t_k (d-slots e_k, q-slots 0) and
+//    three rotations about the midpoint centroid c (d-slots e_k × (x_mid,i − c), q-slots S_i (e_k × p_mid,i)),
+//    S_i the 2×3 selector of node i's chart. For a nodal force vector f, R f = (resultant, moment about c)
+//    with the director forces taken as S_iᵀ f_q,i (theory §3). A finite rigid step (Cayley form
+//    Δx = c' + W x_mid, Δp = W p_mid) lies exactly in the row space of R.
+// 2. The energy–momentum correction F* = F + Rᵀa + β z of a force F (theory §3):
+//      a = −(RRᵀ)⁻¹ R F,   z = Δu − Rᵀ(RRᵀ)⁻¹ R Δu,   β = [ΔU − Δuᵀ(F + Rᵀa)] / zᵀz,
+//    so that R F* = 0 (zero resultant and zero midpoint moment) and Δuᵀ F* = ΔU exactly. When
+//    zᵀz ≤ guard · ΔuᵀΔu (a rigid step, for which ΔU − Δuᵀ(F + Rᵀa) vanishes analytically) β = 0.
+// 3. The embedded kinetic energy and momenta with director velocities w_i ∈ ℝ³ (theory §2): the element's
+//    consistent scalar mass m_ij = ∫ N_i N_j dA is constant, so K, L and J are quadratic/bilinear forms
+//    with constant coefficients.
+// All functions are pure, allocation-free and thread-safe.
+#pragma once
+
+#include "elements/director.hpp"
+
+#include <Eigen/Core>
+#include <array>
+
+namespace shelldyn {
+
+using Vec45E = Eigen::Matrix<double, 45, 1>;
+using RigidRows = Eigen::Matrix<double, 6, 45>;
+using NodeVectors = std::array<Eigen::Vector3d, 9>;
+
+// Rigid rows at the midpoint configuration (item 1).
+RigidRows midpoint_rigid_rows(const NodeVectors& x_mid, const NodeVectors& p_mid,
+                              const std::array<DirectorChart, 9>& charts);
+
+struct CorrectionInfo {
+  double beta = 0.0;         // the coefficient of z
+  double z_norm2 = 0.0;      // zᵀz
+  bool rigid_guard = false;  // β set to 0 because the step is (numerically) rigid
+};
+
+// Replaces F by F* of item 2. du = u_{n+1} − u_n (element DOFs, same charts), dU = U(u_{n+1}) − U(u_n).
+CorrectionInfo energy_momentum_correction(const RigidRows& R, const Vec45E& du, double dU, Vec45E& F,
+                                          double guard = 1e-20);
+
+// Projector Π = I − Rᵀ(RRᵀ)⁻¹R onto the complement of the rigid rows (ΠRᵀ = 0, Π symmetric).
+Eigen::Matrix<double, 45, 45> rigid_complement_projector(const RigidRows& R);
+
+// Embedded kinetic energy ½ρh Σ m_ij v_i·v_j + ½(ρh³/12) Σ m_ij w_i·w_j (theory §2).
+double embedded_kinetic(const Eigen::Matrix<double, 9, 9>& m, double rho_h, double rho_h3_12, const NodeVectors& v,
+                        const NodeVectors& w);
+// Embedded momenta: L = ρh Σ m_ij v_j, J = Σ m_ij [ρh x_i × v_j + (ρh³/12) p_i × w_j]. Either may be null.
+void embedded_momenta(const Eigen::Matrix<double, 9, 9>& m, double rho_h, double rho_h3_12, const NodeVectors& x,
+                      const NodeVectors& p, const NodeVectors& v, const NodeVectors& w, Eigen::Vector3d* L,
+                      Eigen::Vector3d* J);
+
+// A1 of the chart evaluated at a (not necessarily unit) vector p: rows n, m = identity, row l =
+// (−p_n/p_l, −p_m/p_l). Its columns are orthogonal to p and S·A1 = I, so A1ᵀ y = 0 ⇔ y ∥ p (theory §2).
+// Throws std::domain_error if p_l = 0.
+Eigen::Matrix<double, 3, 2> embedded_A1(const Eigen::Vector3d& p, const DirectorChart& ch);
+
+}  // namespace shelldyn

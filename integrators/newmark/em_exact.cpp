@@ -1,0 +1,321 @@
+// em-exact: exactly energy–momentum conserving step (docs/theory/exact-energy-momentum.md; header for the
+// equations and settings).
+#include "integrators/newmark/em_exact.hpp"
+
+#include "elements/exact_energy.hpp"
+#include "integrators/nonlinear/newton_solver.hpp"
+#include "lib/assembler.hpp"
+#include "lib/linear_solver.hpp"
+#include "lib/model.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <sstream>
+
+namespace shelldyn {
+namespace {
+
+class EmExact final : public Integrator, public EmExactDiagnostics {
+ public:
+  EmExact(IntegratorSettings& s, double dt) : dt_(dt) {
+    if (!(dt > 0.0) || !std::isfinite(dt)) throw std::invalid_argument("em-exact: time step dt must be > 0");
+    const double rho_inf = s.get("rho_inf", 1.0);
+    const double xi = s.get("xi", 0.0);
+    if (!(rho_inf > 0.0 && rho_inf <= 1.0)) throw std::invalid_argument("em-exact: rho_inf must be in (0, 1]");
+    if (!(xi >= 0.0 && xi < 0.5)) throw std::invalid_argument("em-exact: xi must be in [0, 0.5)");
+    // Theory §6: on a linear oscillator the step is k[(½+ξ)u_{n+1} + (½−ξ)u_n], whose root tends to
+    // (½−ξ)/(½+ξ) as ωΔt → ∞; ρ∞ < 1 asks for that limit, i.e. ξ = (1−ρ∞)/(2(1+ρ∞)).
+    xi_ = xi + (1.0 - rho_inf) / (2.0 * (1.0 + rho_inf));
+    const std::string newton = s.get("newton", "full");
+    if (newton != "full" && newton != "modified")
+      throw std::invalid_argument("em-exact.newton: '" + newton + "' (use full or modified)");
+    nopt_.modified = (newton == "modified");
+    nopt_.max_setup_calls = s.get("setup_every", 20);
+    nopt_.linear_solver = s.get("linear_solver", "eigen-ldlt");
+    make_linear_solver(nopt_.linear_solver);
+    // KINSOL never stops on its own (tolerances at the bottom of the double range): the iteration hook
+    // applies the residual / stagnation rule of theory §5.
+    nopt_.stop = StopTest::fnorm;
+    nopt_.fnorm_tol = 1e-300;
+    nopt_.step_tol = 0.0;
+    nopt_.min_iters = 1;
+    nopt_.max_iters = s.get("max_iters", 25);
+    nopt_.line_search = false;
+    res_tol_ = s.get("res_tol", 1e-12);
+    stall_tol_ = s.get("stall_tol", 1e-6);
+    stall_ratio_ = s.get("stall_ratio", 0.5);
+    max_cuts_ = s.get("max_cuts", 0);
+    hysteresis_ = s.get("hysteresis", 1.0);
+    correction_ = s.get("correction", true);
+    if (!(res_tol_ > 0.0) || !(stall_tol_ >= 0.0) || !(stall_ratio_ > 0.0 && stall_ratio_ <= 1.0) ||
+        nopt_.max_iters < 1 || max_cuts_ < 0 || hysteresis_ < 1.0)
+      throw std::invalid_argument(
+          "em-exact: need res_tol > 0, stall_tol >= 0, 0 < stall_ratio <= 1, max_iters >= 1, max_cuts >= 0, hysteresis >= 1");
+    resolved_ = s.resolved();
+    char b[64];
+    std::snprintf(b, sizeof b, "%.10g", dt_);
+    resolved_.insert(resolved_.begin(), {"dt", b});
+    std::snprintf(b, sizeof b, "%.10g", xi_);
+    resolved_.emplace_back("xi_effective", b);
+  }
+
+  std::string name() const override { return "em-exact"; }
+  std::vector<std::pair<std::string, std::string>> settings() const override { return resolved_; }
+  double external_work() const override { return work_; }
+  const Data& diagnostics() const override { return diag_; }
+
+  void initialize(SemiDiscreteSystem& sys, State& s) override {
+    model_ = dynamic_cast<Model*>(&sys);
+    if (!model_)
+      throw std::invalid_argument("em-exact: needs the CR9 shell Model (embedded director velocities); got another system");
+    const Index n = sys.num_dofs();
+    nn_ = model_->mesh().num_nodes();
+    newton_ = std::make_unique<NewtonSolver>(sys.pattern(), nopt_);
+    full_newton_.reset();
+    M_ = model_->make_matrix();
+    K_ = M_;
+    for (Eigen::VectorXd* v : {&un_, &umid_, &fint_, &r_, &best_u_}) v->setZero(n);
+    for (Eigen::VectorXd* v : {&vn_, &wn_, &pn_, &p1_, &pmid_, &v1_, &w1_, &mv_, &mw_, &fd_, &g_}) v->setZero(3 * nn_);
+    work_ = 0.0;
+    diag_ = Data{};
+    diag_.min_step_dissipation = std::numeric_limits<double>::infinity();
+    sys.rechart(s, hysteresis_);
+    if (s.pdot.size() != 3 * nn_) {  // embedded director velocities from q̇: w_i = A1_i q̇_i (theory §2)
+      s.pdot.setZero(3 * nn_);
+      for (int i = 0; i < nn_; ++i) {
+        const Index k = DofMap::dof(i, 3);
+        s.pdot.segment<3>(3 * i) = director_A1(s.u.segment<2>(k), s.charts[static_cast<size_t>(i)]) * s.v.segment<2>(k);
+      }
+    }
+    if (s.a.size() != n) s.a.setZero(n);
+    k0_.clear();
+    if (xi_ > 0.0) {
+      k0_.resize(static_cast<size_t>(model_->mesh().num_elements()));
+      for (int e = 0; e < model_->mesh().num_elements(); ++e) k0_[static_cast<size_t>(e)] = model_->reference_local_stiffness(e);
+    }
+  }
+
+  StepReport advance(SemiDiscreteSystem& sys, State& s, double t_out) override {
+    if (!newton_ || model_ != &sys) throw std::logic_error("em-exact: advance() before initialize() (or on another system)");
+    const auto start = std::chrono::steady_clock::now();
+    StepReport rep;
+    while (s.t < t_out - 1e-12 * dt_) {
+      double h = std::min(dt_, t_out - s.t);
+      if (t_out - (s.t + h) < 1e-9 * dt_) h = t_out - s.t;
+      step_with_cuts(s, h, 0, rep);
+    }
+    rep.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return rep;
+  }
+
+ private:
+  void step_with_cuts(State& s, double h, int depth, StepReport& rep) {
+    std::string why;
+    if (step(s, h, rep, &why)) return;
+    ++rep.rejected_steps;
+    if (nopt_.modified) {
+      if (step(s, h, rep, &why, true)) return;
+      ++rep.rejected_steps;
+    }
+    if (depth >= max_cuts_) {
+      std::ostringstream msg;
+      msg.precision(10);
+      msg << "em-exact: step " << steps_ + 1 << " from t = " << s.t << " with dt = " << h << " failed"
+          << (max_cuts_ > 0 ? " after " + std::to_string(depth) + " cuts" : std::string(" (step cutting is off: set max_cuts)"))
+          << ": " << why;
+      throw StepFailure(msg.str());
+    }
+    step_with_cuts(s, 0.5 * h, depth + 1, rep);
+    step_with_cuts(s, 0.5 * h, depth + 1, rep);
+  }
+
+  // Directors p(q) of all nodes (3 per node) in the step's charts.
+  void directors(const Eigen::VectorXd& u, const std::vector<DirectorChart>& charts, Eigen::VectorXd& p) const {
+    for (int i = 0; i < nn_; ++i)
+      p.segment<3>(3 * i) = director(u.segment<2>(DofMap::dof(i, 3)), charts[static_cast<size_t>(i)]);
+  }
+
+  // Midpoint quantities of the trial u_{n+1}: p_{n+1}, p_mid, v_{n+1}, w_{n+1}, M_d Δv/h, M_p Δw/h, loads.
+  void kinematics(const Eigen::VectorXd& u, const std::vector<DirectorChart>& charts, double h, double tmid) {
+    directors(u, charts, p1_);
+    pmid_ = 0.5 * (pn_ + p1_);
+    for (int i = 0; i < nn_; ++i) {
+      const Index k = DofMap::dof(i, 0);
+      v1_.segment<3>(3 * i) = (2.0 / h) * (u.segment<3>(k) - un_.segment<3>(k)) - vn_.segment<3>(3 * i);
+    }
+    w1_ = (2.0 / h) * (p1_ - pn_) - wn_;
+    const ShellMaterial& mat = model_->material();
+    const double rh = mat.rho * mat.thickness, rh3 = rh * mat.thickness * mat.thickness / 12.0;
+    model_->scalar_mass_times(v1_ - vn_, mv_);
+    mv_ *= rh / h;
+    model_->scalar_mass_times(w1_ - wn_, mw_);
+    mw_ *= rh3 / h;
+    model_->embedded_external(tmid, pmid_, fd_, g_);
+  }
+
+  bool step(State& s, double h, StepReport& rep, std::string* why, bool full_newton = false) {
+    Model& sys = *model_;
+    rep.chart_switches += sys.rechart(s, hysteresis_);  // between steps only; d, p, v, w unchanged
+    if (h != last_h_) newton_->invalidate_jacobian();
+    last_h_ = h;
+    if (full_newton && !full_newton_) {
+      NewtonOptions full = nopt_;
+      full.modified = false;
+      full_newton_ = std::make_unique<NewtonSolver>(sys.pattern(), full);
+    }
+    NewtonSolver& newton = full_newton ? *full_newton_ : *newton_;
+    const auto& charts = s.charts;
+    const Index n = sys.num_dofs();
+    const double t1 = s.t + h, tmid = s.t + 0.5 * h;
+    un_ = s.u;
+    for (int i = 0; i < nn_; ++i) vn_.segment<3>(3 * i) = s.v.segment<3>(DofMap::dof(i, 0));
+    wn_ = s.pdot;
+    directors(un_, charts, pn_);
+    sys.element_energies(un_, charts, Un_);
+
+    std::vector<double> history;  // scaled residual of every evaluated iterate
+    double best = std::numeric_limits<double>::infinity();
+    Model::ExactForceInfo finfo;
+    int last_jacobian_iter = 0;
+
+    auto residual = [&](const double* up, double* rp) {
+      const Eigen::Map<const Eigen::VectorXd> u(up, n);
+      kinematics(u, charts, h, tmid);
+      sys.exact_internal(un_, u, charts, Un_, correction_, xi_, xi_ > 0.0 ? &k0_ : nullptr, fint_.data(), nullptr,
+                         nullptr, &finfo);
+      Eigen::Map<Eigen::VectorXd> r(rp, n);
+      double scale = 0.0;
+      for (int i = 0; i < nn_; ++i) {
+        const Index k = DofMap::dof(i, 0);
+        const Vec3 Ad = mv_.segment<3>(3 * i), Ap = mw_.segment<3>(3 * i);
+        const Vec3 fd = fd_.segment<3>(3 * i), g = g_.segment<3>(3 * i);
+        // Theory §2 / §4: translational balance, and the director balance projected by A1(p_mid)ᵀ.
+        r.segment<3>(k) = Ad + fint_.segment<3>(k) - fd;
+        const DirectorChart& ch = charts[static_cast<size_t>(i)];
+        r.segment<2>(k + 3) = embedded_A1(Vec3(pmid_.segment<3>(3 * i)), ch).transpose() * (Ap - g) + fint_.segment<2>(k + 3);
+        scale = std::max({scale, Ad.cwiseAbs().maxCoeff(), Ap.cwiseAbs().maxCoeff(), fd.cwiseAbs().maxCoeff(),
+                          g.cwiseAbs().maxCoeff(), fint_.segment<5>(k).cwiseAbs().maxCoeff()});
+      }
+      zero_constrained(sys.dofs(), rp);
+      if (!r.allFinite()) throw std::runtime_error("non-finite residual");
+      const double rn = r.cwiseAbs().maxCoeff();
+      const double rel = rn == 0.0 ? 0.0 : rn / scale;
+      history.push_back(rel);
+      if (rel < best) {
+        best = rel;
+        best_u_ = u;
+      }
+    };
+    auto jacobian = [&](const double* up, SparseMatrix& J) {
+      const Eigen::Map<const Eigen::VectorXd> u(up, n);
+      umid_ = 0.5 * (u + un_);
+      // Theory §5: em-galpha's symmetric K̄ = (2/Δt²) M(u_mid) + ½ K_mid (+ ξ G), an approximate Jacobian.
+      sys.mass(umid_, charts, M_);
+      sys.exact_internal(un_, u, charts, Un_, false, xi_, xi_ > 0.0 ? &k0_ : nullptr, nullptr, &K_, nullptr, nullptr);
+      sys.add_load_stiffness(tmid, umid_, charts, K_);
+      const double cm = 2.0 / (h * h);
+      for (size_t k = 0; k < J.values.size(); ++k) J.values[k] = cm * M_.values[k] + 0.5 * K_.values[k];
+      apply_dirichlet(sys.dofs(), J, nullptr);
+      last_jacobian_iter = static_cast<int>(history.size());  // used for the iteration that follows
+    };
+    auto hook = [&](int k, const double*, const double*, const double*) -> bool {
+      const double rk = history.back();
+      if (rk <= res_tol_) return true;
+      double prev_best = std::numeric_limits<double>::infinity();
+      for (size_t j = 0; j + 1 < history.size(); ++j) prev_best = std::min(prev_best, history[j]);
+      if (rk <= stall_tol_ && rk > stall_ratio_ * prev_best) {
+        // Stagnation: at the round-off floor if the iteration matrix was fresh; otherwise refresh it first.
+        if (last_jacobian_iter >= k - 1) return true;
+        newton.invalidate_jacobian();
+      }
+      return false;
+    };
+
+    Eigen::VectorXd u = un_;  // predictor u_{n+1} = u_n (theory §5)
+    best_u_ = u;
+    const NewtonSolver::Result r = newton.solve(u.data(), residual, jacobian, nullptr, nullptr, hook);
+    if (full_newton) newton_->invalidate_jacobian();
+    rep.nonlinear_iterations += r.iterations;
+    rep.linear_setups += r.jacobian_evals;
+    rep.factorizations += r.factorizations;
+    rep.rhs_evaluations += r.residual_evals;
+    rep.residual_norm = best;
+    if (!r.converged) {
+      std::ostringstream os;
+      os << r.message << " (best scaled residual " << best << ", iterations = " << r.iterations << ")";
+      *why = os.str();
+      return false;
+    }
+    u = best_u_;
+    // Final quantities at the accepted iterate.
+    kinematics(u, charts, h, tmid);
+    if (xi_ > 0.0) {
+      Model::ExactForceInfo fi;
+      sys.exact_internal(un_, u, charts, Un_, correction_, xi_, &k0_, fint_.data(), nullptr, nullptr, &fi);
+      diag_.dissipation += fi.dissipation;
+      diag_.min_step_dissipation = std::min(diag_.min_step_dissipation, fi.dissipation);
+      diag_.max_beta_z = std::max(diag_.max_beta_z, fi.max_beta_z);
+      diag_.rigid_guards += fi.rigid_guards;
+    } else {
+      diag_.max_beta_z = std::max(diag_.max_beta_z, finfo.max_beta_z);
+      diag_.rigid_guards += finfo.rigid_guards;
+      diag_.min_step_dissipation = std::min(diag_.min_step_dissipation, 0.0);
+    }
+    diag_.max_residual = std::max(diag_.max_residual, best);
+    // External work as the scheme evaluates it (theory §4): F_ext(t_mid)·Δd + Σ g_i·Δp_i.
+    double dw = g_.dot(p1_ - pn_);
+    for (int i = 0; i < nn_; ++i) {
+      const Index k = DofMap::dof(i, 0);
+      dw += fd_.segment<3>(3 * i).dot(u.segment<3>(k) - un_.segment<3>(k));
+    }
+    work_ += dw;
+    // New state: v, w from the trapezoidal relations; q̇ and q̈ entries hold the chart's minor components of
+    // w and Δw/Δt (for output only: the scheme's state is (d, p, v, w)); a_d = Δv/Δt.
+    for (int i = 0; i < nn_; ++i) {
+      const Index k = DofMap::dof(i, 0);
+      const DirectorChart& ch = charts[static_cast<size_t>(i)];
+      s.v.segment<3>(k) = v1_.segment<3>(3 * i);
+      s.a.segment<3>(k) = (v1_.segment<3>(3 * i) - vn_.segment<3>(3 * i)) / h;
+      s.v.segment<2>(k + 3) = chart_coordinates(Vec3(w1_.segment<3>(3 * i)), ch);
+      s.a.segment<2>(k + 3) = chart_coordinates(Vec3((w1_ - wn_).segment<3>(3 * i) / h), ch);
+    }
+    s.pdot = w1_;
+    s.u = u;
+    s.t = t1;
+    ++steps_;
+    ++rep.steps;
+    rep.last_dt = h;
+    return true;
+  }
+
+  double dt_;
+  double xi_ = 0.0;
+  NewtonOptions nopt_;
+  double res_tol_ = 1e-12, stall_tol_ = 1e-6, stall_ratio_ = 0.5;
+  int max_cuts_ = 0;
+  double hysteresis_ = 1.0;
+  bool correction_ = true;
+  std::vector<std::pair<std::string, std::string>> resolved_;
+
+  Model* model_ = nullptr;
+  int nn_ = 0;
+  std::unique_ptr<NewtonSolver> newton_, full_newton_;
+  SparseMatrix M_, K_;
+  std::vector<CR9Shell::Mat45> k0_;
+  std::vector<double> Un_;
+  Eigen::VectorXd un_, umid_, fint_, r_, best_u_;
+  Eigen::VectorXd vn_, wn_, pn_, p1_, pmid_, v1_, w1_, mv_, mw_, fd_, g_;
+  double work_ = 0.0;
+  double last_h_ = 0.0;
+  long steps_ = 0;
+  Data diag_;
+};
+
+}  // namespace
+
+std::unique_ptr<Integrator> make_em_exact(IntegratorSettings& s, double dt) { return std::make_unique<EmExact>(s, dt); }
+
+}  // namespace shelldyn

@@ -1,0 +1,43 @@
+// em-exact: an exactly energy–momentum conserving step for the CR9 shell model
+// (docs/theory/exact-energy-momentum.md; it goes beyond Li & Qian (2025), whose scheme em-galpha reproduces).
+//
+// Per node the scheme carries position, director and their velocities in ℝ³ (d_i, p_i, v_i, w_i; State::pdot
+// holds w). The unknowns of a step are u_{n+1} = [d, q] in the charts fixed at the step start. Trapezoidal
+// relations v_{n+1} = 2Δd/Δt − v_n, w_{n+1} = 2Δp/Δt − w_n; balance at the midpoint (theory §2, §4):
+//   translations  M_d (v_{n+1} − v_n)/Δt + F*_d − F_ext(t_mid) = 0
+//   directors     A1(p_mid)ᵀ [M_p (w_{n+1} − w_n)/Δt − g(t_mid)] + F*_q = 0,   p_mid = (p_n + p_{n+1})/2
+// with the per-element corrected force F* of theory §3 (R F* = 0, Δuᵀ F* = ΔU) plus, when dissipative, the
+// force ξ G Δu of theory §6. Results, for any Δt, to the Newton residual:
+//   K + V − W_ext constant (ξ = 0) or decreasing by Σ ξ ΔuᵀGΔu ≥ 0 per step; L exact; J exact without loads.
+//
+// Settings: rho_inf [1] and xi [0] (dissipation; ξ_eff = ξ + (1−ρ∞)/(2(1+ρ∞)), theory §6),
+//   newton full|modified [full], setup_every [20], linear_solver [eigen-ldlt], res_tol [1e-12],
+//   stall_tol [1e-6], stall_ratio [0.5], max_iters [25], max_cuts [0], hysteresis [1],
+//   correction [true] (false = the paper's force without the §3 correction: for tests that must fail).
+// Stopping (theory §5): the scaled residual ‖r‖∞ / (‖inertia‖∞ + ‖F*‖∞ + ‖F_ext‖∞) ≤ res_tol, or, once it is
+// below stall_tol, an iteration that does not reduce the best residual by stall_ratio (the round-off floor of
+// the co-rotational force); the best iterate is kept.
+#pragma once
+
+#include "integrators/integrator.hpp"
+
+namespace shelldyn {
+
+std::unique_ptr<Integrator> make_em_exact(IntegratorSettings& settings, double dt);
+
+// What em-exact measured beyond StepReport (for tests and studies): read through
+// dynamic_cast<const EmExactDiagnostics*>(integrator.get()).
+class EmExactDiagnostics {
+ public:
+  virtual ~EmExactDiagnostics() = default;
+  struct Data {
+    double dissipation = 0.0;       // Σ over steps of ξ ΔuᵀGΔu (energy removed, ≥ 0)
+    double min_step_dissipation = 0.0;  // smallest per-step dissipation seen (≥ 0 by theory §6)
+    double max_residual = 0.0;      // largest accepted scaled residual of any step
+    double max_beta_z = 0.0;        // largest relative size of the energy correction β z
+    long rigid_guards = 0;          // element-steps treated as rigid (β = 0)
+  };
+  virtual const Data& diagnostics() const = 0;
+};
+
+}  // namespace shelldyn
