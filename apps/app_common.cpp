@@ -294,7 +294,9 @@ int BenchmarkApp::run() {
   }
   if (report) report(AppResult{&problem, &s, out_dir});
   if (!o_.no_plots) {
-    std::vector<std::string> args{out_dir, "--title", (label.empty() ? problem.spec.name : label) + ", " + run_label(s.integrator, overrides)};
+    // The benchmark cases use SI units (docs/benchmarks.md), so the figures are labelled in SI.
+    std::vector<std::string> args{out_dir, "--units", "SI", "--title",
+                                  (label.empty() ? problem.spec.name : label) + ", " + run_label(s.integrator, overrides)};
     if (run_python_script(find_script("plot_run.py"), args, std::cout))
       std::cout << "wrote " << out_dir << "/energy.png, " << out_dir << "/momentum.png, " << out_dir << "/monitors.png\n";
   }

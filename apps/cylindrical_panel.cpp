@@ -1,5 +1,5 @@
 // cylindrical_panel — free large overall motion of a cylindrical panel, Li & Qian (2025) §4.2 after
-// Sansour et al. (spec/benchmarks.md §2), in its PROVISIONAL form CYP-prov (§2.3): R = 150, opening
+// Sansour et al. (docs/benchmarks.md §2), in its PROVISIONAL form CYP-prov (§2.3): R = 150, opening
 // 0.2 rad, length 30, h = 1, E = 31027.5, nu = 0.3 as printed; rho = 1e-8 and dt = 1e-5 with their lost
 // minus signs restored; the 4 x 6 mesh orientation and the corner load (0,1,1)·f(t), f = hat of peak
 // 1 N at 0.01 s, off at 0.02 s, are our reading.
@@ -21,6 +21,6 @@ int main(int argc, char** argv) {
   app.label = "CYP-prov";
   app.provisional =
       "CYP-prov: rho = 1e-8 and dt = 1e-5 have restored exponent signs, the 4 x 6 mesh orientation and the "
-      "corner load are our reading (spec/benchmarks.md §2.3)";
+      "corner load are our reading (docs/benchmarks.md §2.3)";
   return app.main(argc, argv);
 }

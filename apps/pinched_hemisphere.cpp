@@ -1,5 +1,5 @@
 // pinched_hemisphere — the dynamic pinched hemisphere with an 18° hole of Li & Qian (2025) §4.3
-// (spec/benchmarks.md §3): R = 10, h = 0.04, E = 6.825e7, nu = 0.3, full shell of 256 nine-node
+// (docs/benchmarks.md §3): R = 10, h = 0.04, E = 6.825e7, nu = 0.3, full shell of 256 nine-node
 // elements, four alternating equator loads P(t) = triangle of peak 100 N at 0.015 s, off at 0.03 s,
 // dt = 1.25e-4 s, 1.25 s.
 //
@@ -40,7 +40,7 @@ int main(int argc, char** argv) {
                         "Dynamic pinched hemisphere with an 18 degree hole, Li & Qian (2025) §4.3");
   const double paper_period = 0.04;  // Li & Qian (2025) §4.3
   double density = 1000.0;
-  app.cli().add_option("--density", density, "Density rho: 1000 as printed (default) or 1e-3 (matches the reported 0.04 s period; spec/benchmarks.md §3.3)");
+  app.cli().add_option("--density", density, "Density rho: 1000 as printed (default) or 1e-3 (matches the reported 0.04 s period; docs/benchmarks.md §3.3)");
 
   app.validate = [&] {
     if (!(density > 0.0) || !std::isfinite(density))
@@ -52,7 +52,7 @@ int main(int argc, char** argv) {
     os << density;
     app.folder_suffix = "-rho" + os.str();
     app.label = "hemisphere rho=" + os.str();
-    spec.description = "Dynamic pinched hemisphere (benchmarks.md §3), rho = " + os.str() +
+    spec.description = "Dynamic pinched hemisphere (docs/benchmarks.md §3), rho = " + os.str() +
                        (density == 1000.0 ? " as printed" : " (not as printed; see §3.3)");
   };
   app.before_run = [&](const Problem& problem) {

@@ -203,7 +203,7 @@ struct RunCommandOptions {
   std::vector<std::string> settings;  // key=value
   double dt = 0.0, t_end = -1.0, output_every = 0.0;
   int vtu_every = -1, threads = 0;
-  bool quiet = false;
+  bool quiet = false, plots = false;
 };
 
 std::pair<std::string, std::string> split_setting(const std::string& kv) {
@@ -231,8 +231,23 @@ int run_run(const RunCommandOptions& o) {
   ro.out_dir = o.out_dir.empty() ? (fs::path("results") / problem.spec.name / integrator).string() : o.out_dir;
   std::cout << "shelldyn run: " << problem.spec.name << " with " << integrator << " -> " << ro.out_dir << std::endl;
   const RunSummary s = run_dynamic(problem, ro);
-  print_run_summary(std::cout, s);
-  std::cout << "wrote " << ro.out_dir << "/history.csv, " << ro.out_dir << "/fields.pvd, " << ro.out_dir << "/run.json\n";
+  if (o.quiet) {  // one line: status, steps, energy error after the loads
+    std::printf("%s: %s, %ld steps, max |H - H_ref|/(K+V)_ref after loads %.3g -> %s\n", integrator.c_str(),
+                s.status.c_str(), s.totals.steps, s.max_rel_drift, ro.out_dir.c_str());
+  } else {
+    print_run_summary(std::cout, s);
+    std::cout << "wrote " << ro.out_dir << "/history.csv, " << ro.out_dir << "/fields.pvd, " << ro.out_dir << "/run.json\n";
+  }
+  if (o.plots) {  // scripts/plot_run.py: energy.png, momentum.png, monitors.png (docs/manual.md §4)
+    for (const char* png : {"energy.png", "momentum.png", "monitors.png"}) {
+      std::error_code ec;
+      fs::remove(fs::path(ro.out_dir) / png, ec);
+    }
+    if (!app::run_python_script(app::find_script("plot_run.py"), {ro.out_dir, "--title", problem.spec.name + ", " + integrator},
+                                std::cout))
+      return 1;
+    if (!o.quiet) std::cout << "wrote " << ro.out_dir << "/energy.png, momentum.png, monitors.png\n";
+  }
   return 0;
 }
 
@@ -251,7 +266,8 @@ void add_run_command(CLI::App& app, Action& action, const std::string& command) 
   sub->add_option("--output-every", o->output_every, "Output interval in time units (default: the case's time.output_interval)");
   sub->add_option("--vtu-every", o->vtu_every, "Write a VTU every N output times; 0 disables (default: the case's output.vtu_every)");
   sub->add_option("--threads", o->threads, "OpenMP threads for element loops (default: all cores)")->check(CLI::NonNegativeNumber);
-  sub->add_flag("-q,--quiet", o->quiet, "No progress lines");
+  sub->add_flag("-q,--quiet", o->quiet, "No progress line and no summary table: one result line (errors still reported)");
+  sub->add_flag("--plots", o->plots, "After the run, write energy.png, momentum.png, monitors.png with scripts/plot_run.py (needs python3-matplotlib)");
   sub->callback([o, &action] { action = [o] { return run_run(*o); }; });
 }
 
@@ -272,7 +288,13 @@ int run_static_command(const CheckOptions& o) {
 void add_static_command(CLI::App& app, Action& action, const std::string& command) {
   auto opts = std::make_shared<CheckOptions>();
   opts->command = command;
-  CLI::App* sub = app.add_subcommand("static", "Solve a static case by load stepping (integrator: static); write static.csv, VTU/PVD, run.json");
+  CLI::App* sub = app.add_subcommand(
+      "static",
+      "Solve a static case by load stepping (integrator: static); write static.csv, VTU/PVD, run.json.\n"
+      "Case settings (integrator: {name: static, ...}; docs/manual.md §3): increment=time.dt (load-factor step), "
+      "min_increment=increment*1e-4, growth=1.5, easy_iterations=6, hysteresis=1, max_iters=30, tol=1e-9 "
+      "(max-norm residual relative to the applied load), linear_solver=eigen-ldlt (klu: full non-symmetric "
+      "follower-load tangent), line_search=false. The load factor runs from 0 to time.t_end.");
   sub->add_option("case", opts->case_path, "Case file (YAML), e.g. apps/cases/sze-hemisphere.yaml")->required();
   sub->add_option("-o,--output", opts->out_dir, "Result folder (default: results/<case>/static)");
   sub->callback([opts, &action] { action = [opts] { return run_static_command(*opts); }; });

@@ -1,4 +1,4 @@
-// Timing of the CR9 element kernels (spec/element.md §3.4, §4, §6.3). Target: internal() with F and K
+// Timing of the CR9 element kernels (docs/theory.md §3.4, §4, §6.3). Target: internal() with F and K
 // <= 50 µs per element. Run: build/bin/bench_element [--benchmark_filter=Internal]
 #include <benchmark/benchmark.h>
 

@@ -1,5 +1,5 @@
 // Factorize and solve times of the LinearSolver back-ends on 9-node-shell patterns
-// (spec/stack.md §5.1): ne x ne quadratic quads, (2ne+1)^2 nodes, 5 DOF per node, random SPD
+// (docs/dependencies.md §5.1): ne x ne quadratic quads, (2ne+1)^2 nodes, 5 DOF per node, random SPD
 // element blocks B Bᵀ/45 + 0.01 I. ne = 16 is the size of the 256-element hemisphere benchmark
 // (33 x 33 nodes, 5445 DOFs); ne = 8 is given for scale.
 //

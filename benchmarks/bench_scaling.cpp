@@ -92,9 +92,15 @@ CaseSpec plate_case(int n) {
   return load_case_from_string(y.str(), "scaling-plate.yaml");
 }
 
-long cholmod_analysis(const CscView& A, double* flops) {
+// ordering < 0: CHOLMOD's default strategy; else only that method (CHOLMOD_AMD, CHOLMOD_METIS, ...).
+long cholmod_analysis(const CscView& A, double* flops, int ordering = -1) {
   cholmod_common c;
   cholmod_l_start(&c);
+  if (ordering >= 0) {
+    c.nmethods = 1;
+    c.method[0].ordering = ordering;
+    c.postorder = 1;
+  }
   cholmod_sparse S{};
   S.nrow = S.ncol = static_cast<size_t>(A.n);
   S.nzmax = static_cast<size_t>(A.nnz());
@@ -127,7 +133,7 @@ int main(int argc, char** argv) {
     return 0;
   }
   if (argc < 3) {
-    std::cerr << "usage: bench_scaling hemisphere|plate N [--threads T] [--steps S] [--skip SOLVER] | --header\n";
+    std::cerr << "usage: bench_scaling hemisphere|plate N [--threads T] [--steps S] [--skip SOLVER] [--fill-only] | --header\n";
     return 2;
   }
   try {
@@ -135,8 +141,15 @@ int main(int argc, char** argv) {
     const int n = std::stoi(argv[2]);
     int threads = 1, steps = 3;
     std::vector<std::string> skip;
-    for (int k = 3; k + 1 < argc; k += 2) {
+    bool fill_only = false;
+    for (int k = 3; k < argc; k += 2) {
       const std::string a = argv[k];
+      if (a == "--fill-only") {
+        fill_only = true;
+        --k;
+        continue;
+      }
+      if (k + 1 >= argc) throw std::invalid_argument("option " + a + " needs a value");
       if (a == "--threads") threads = std::stoi(argv[k + 1]);
       else if (a == "--steps") steps = std::stoi(argv[k + 1]);
       else if (a == "--skip") skip.push_back(argv[k + 1]);
@@ -171,6 +184,14 @@ int main(int argc, char** argv) {
     for (size_t k = 0; k < K.values.size(); ++k) K.values[k] = M.values[k] / (0.25 * dt * dt) + K.values[k];
     double flops = 0.0;
     const long lnz = cholmod_analysis(K.view(), &flops);
+    if (fill_only) {  // --fill-only: mesh,n,unknowns,nnz_K, then nnz(L) and flops for default / AMD / METIS orderings
+      double f_amd = 0.0, f_metis = 0.0;
+      const long l_amd = cholmod_analysis(K.view(), &f_amd, CHOLMOD_AMD);
+      const long l_metis = cholmod_analysis(K.view(), &f_metis, CHOLMOD_METIS);
+      std::printf("%s,%d,%lld,%lld,%ld,%.6g,%ld,%.6g,%ld,%.6g\n", mesh.c_str(), n, static_cast<long long>(m.num_dofs()),
+                  static_cast<long long>(K.pattern->nnz()), lnz, flops, l_amd, f_amd, l_metis, f_metis);
+      return 0;
+    }
     double factor[2] = {std::nan(""), std::nan("")}, factor_cpu[2] = {std::nan(""), std::nan("")};
     const char* solvers[2] = {"eigen-ldlt", "cholmod"};
     for (int j = 0; j < 2; ++j) {

@@ -3,8 +3,8 @@
 // Benchmark: one run per row is already long enough to time).
 //
 //   bench_sundials_baselines                 # all tables (several minutes on 2 cores)
-//   bench_sundials_baselines flight [t_end]  # free flight of spec/element.md §7 item 12 only
-//   bench_sundials_baselines spin [t_end]    # rigid spin R2 of spec/benchmarks.md §6 only
+//   bench_sundials_baselines flight [t_end]  # free flight of docs/theory.md §7 item 12 only
+//   bench_sundials_baselines spin [t_end]    # rigid spin R2 of docs/benchmarks.md §6 only
 //   bench_sundials_baselines jacobian        # ida-bdf Newton iterations: approximate vs fd-inertia Jacobian
 //   bench_sundials_baselines plate [case]    # free-flight phase of the flying plate, t = 5 .. 6
 //   bench_sundials_baselines one CASE INTEGRATOR T_END key=value ...   # a single row
@@ -84,7 +84,7 @@ void run_row(SemiDiscreteSystem& sys, State s, const std::string& name, const Ke
 }
 
 void flight_table(double t_end) {
-  std::printf("\n### Free flight (element.md §7 item 12), t = 0 .. %g\n\n", t_end);
+  std::printf("\n### Free flight (docs/theory.md §7 item 12), t = 0 .. %g\n\n", t_end);
   header();
   auto model = flight_plate();
   const State s0 = flight_state(*model);
@@ -96,7 +96,7 @@ void flight_table(double t_end) {
 }
 
 void spin_table(double t_end) {
-  std::printf("\n### Rigid spin R2 (benchmarks.md §6), t = 0 .. %g\n\n", t_end);
+  std::printf("\n### Rigid spin R2 (docs/benchmarks.md §6), t = 0 .. %g\n\n", t_end);
   header();
   auto model = spin_plate();
   const State s0 = spin_state(*model, Vec3(1, 0, 0));

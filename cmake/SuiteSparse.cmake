@@ -1,4 +1,4 @@
-# SuiteSparse 5.12 (Debian 12) ships no CMake config: find KLU and CHOLMOD by hand (spec/stack.md §2.1).
+# SuiteSparse 5.12 (Debian 12) ships no CMake config: find KLU and CHOLMOD by hand (docs/dependencies.md §2.1).
 if(NOT TARGET SuiteSparse::KLU)
   find_path(SUITESPARSE_INCLUDE_DIR klu.h PATH_SUFFIXES suitesparse REQUIRED)
   find_library(KLU_LIBRARY klu REQUIRED)

@@ -1,4 +1,4 @@
-// Co-rotational triad, T and K_σ: spec/element.md §3.1-3.4.
+// Co-rotational triad, T and K_σ: docs/theory.md §3.1-3.4.
 #include "elements/corotational_frame.hpp"
 
 #include <Eigen/Geometry>

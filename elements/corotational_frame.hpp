@@ -1,4 +1,4 @@
-// Co-rotational frame of the 9-node element and the global <-> local map (spec/element.md §3).
+// Co-rotational frame of the 9-node element and the global <-> local map (docs/theory.md §3).
 //
 // The element triad follows the unit diagonals of the current corner positions (§3.1):
 //   a = x3 - x1, b = x4 - x2, e_x = (â - b̂)/|â - b̂|, e_y = (â + b̂)/|â + b̂|, e_z = e_x × e_y,

@@ -1,4 +1,4 @@
-// CR9 shell element: spec/element.md §2.4 (set-up), §3.4 (global force/tangent), §4 (local strains,
+// CR9 shell element: docs/theory.md §2.4 (set-up), §3.4 (global force/tangent), §4 (local strains,
 // MITC9, resultants), §5 (inertia), §6.3 (strain-averaged algorithmic force).
 #include "elements/cr9_shell.hpp"
 
@@ -93,7 +93,7 @@ CR9Shell::CR9Shell(const std::array<Eigen::Vector3d, 9>& X0, const std::array<Ei
     if (!p0[i].allFinite() || std::abs(p0[i].norm() - 1.0) > 1e-8) {
       std::ostringstream os;
       os << "CR9Shell: initial normal p0 of " << node_name(i) << " = (" << p0[i].transpose() << ") has length "
-         << p0[i].norm() << "; pass unit normals (normalise after averaging, spec §2.4)";
+         << p0[i].norm() << "; pass unit normals (normalise after averaging, docs/theory.md §2.4)";
       throw std::invalid_argument(os.str());
     }
   }
@@ -121,7 +121,7 @@ CR9Shell::CR9Shell(const std::array<Eigen::Vector3d, 9>& X0, const std::array<Ei
       std::ostringstream os;
       os << "CR9Shell: orientation check failed at " << node_name(i) << ": e_z0·p0 = " << r0[i](2)
          << " <= 0 (element normal from the corner numbering points away from the nodal normal); number the "
-            "corners counter-clockwise seen from the normal side, or flip the element (spec §2.4)";
+            "corners counter-clockwise seen from the normal side, or flip the element (docs/theory.md §2.4)";
       throw std::invalid_argument(os.str());
     }
     th0_[i] = r0[i].head<2>();
@@ -185,7 +185,7 @@ CR9Shell::CR9Shell(const std::array<Eigen::Vector3d, 9>& X0, const std::array<Ei
         std::ostringstream os;
         os << "CR9Shell: degenerate or folded element: at Gauss point (" << xi << ", " << eta
            << ") the mid-surface Jacobian has normal (" << nrm.transpose()
-           << ") in the element frame; check node positions and the counter-clockwise numbering (spec §1)";
+           << ") in the element frame; check node positions and the counter-clockwise numbering (docs/theory.md §1)";
         throw std::invalid_argument(os.str());
       }
       const Eigen::Vector3d t2 = nrm.normalized().cross(t1);
@@ -210,6 +210,7 @@ CR9Shell::CR9Shell(const std::array<Eigen::Vector3d, 9>& X0, const std::array<Ei
       for (int al = 0; al < 2; ++al) Bs.row(al) = j(al, 0) * g[0] + j(al, 1) * g[1];
       // §4.7 constant parts of k_L: B_b^T (h^3 D1/12) B_b + B_s^T (h D2) B_s.
       Kbs_.noalias() += dA * (Bb.transpose() * Db * Bb + Ds * Bs.transpose() * Bs);
+      Bbs_[static_cast<size_t>(3 * ig + jg)] << Bb, Bs;
       const Eigen::Matrix<double, 9, 1> N = shape_functions(xi, eta);
       m_.noalias() += dA * N * N.transpose();  // §5.1 m_ij
       area_ += dA;
@@ -429,6 +430,36 @@ void CR9Shell::inertial(const Vec45& u, const Vec45& v, const Charts& charts, Ve
     // §5.2: F_m at node i = (ρh³/12) A1_i^T Σ_j m_ij A2_j (no translational part).
     Fm->segment<2>(5 * i + 3) = rh3 * director_A1(u.segment<2>(5 * i + 3), charts[i]).transpose() * s;
   }
+}
+
+CR9Shell::Resultants CR9Shell::resultants(const Vec45& u, const Charts& charts) const {
+  Vec45 w;
+  local_increments(u, charts, &w);
+  const Mat39 t = translations(w);
+  const Eigen::Map<const Eigen::Matrix<double, 27, 1>> v(t.data());
+  const double h = mat_.thickness, G = mat_.E / (2.0 * (1.0 + mat_.nu));
+  Resultants r;
+  r.membrane_strain.setZero(), r.curvature.setZero(), r.shear_strain.setZero();
+  r.membrane_force.setZero(), r.bending_moment.setZero(), r.shear_force.setZero();
+  double U = 0.0;
+  for (size_t g = 0; g < gp_.size(); ++g) {
+    const GaussPoint& gp = gp_[g];
+    Eigen::Vector3d e;
+    for (int c = 0; c < 3; ++c) e(c) = gp.Lm.row(c).dot(v) + 0.5 * t.lazyProduct(gp.Hm[c]).cwiseProduct(t).sum();
+    const Eigen::Matrix<double, 5, 1> bs = Bbs_[g] * w;
+    const Eigen::Vector3d chi = bs.head<3>();
+    const Eigen::Vector2d gam = bs.tail<2>();
+    const Eigen::Vector3d N = h * D1_ * e, M = (h * h * h / 12.0) * D1_ * chi;
+    const Eigen::Vector2d Q = mat_.shear_factor * G * h * gam;
+    r.membrane_strain += gp.dA * e, r.curvature += gp.dA * chi, r.shear_strain += gp.dA * gam;
+    r.membrane_force += gp.dA * N, r.bending_moment += gp.dA * M, r.shear_force += gp.dA * Q;
+    U += 0.5 * gp.dA * (e.dot(N) + chi.dot(M) + gam.dot(Q));
+  }
+  const double A = area_;
+  r.membrane_strain /= A, r.curvature /= A, r.shear_strain /= A;
+  r.membrane_force /= A, r.bending_moment /= A, r.shear_force /= A;
+  r.energy_density = U / A;
+  return r;
 }
 
 double CR9Shell::kinetic(const Vec45& u, const Vec45& v, const Charts& charts) const {

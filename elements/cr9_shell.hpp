@@ -1,7 +1,7 @@
 // CR9: co-rotational 9-node shell element with vectorial rotational variables
-// (spec/element.md §§1-6.3; Li & Qian 2025, Li, Izzuddin & Vu-Quoc 2008), MITC9 assumed strains.
+// (docs/theory.md §§1-6.3; Li & Qian 2025, Li, Izzuddin & Vu-Quoc 2008), MITC9 assumed strains.
 //
-// Node numbering (spec §1, Gmsh type 10; 0-based index in code = node - 1):
+// Node numbering (docs/theory.md §1, Gmsh type 10; 0-based index in code = node - 1):
 //
 //      4 ---- 7 ---- 3        eta
 //      |             |         ^
@@ -85,6 +85,15 @@ class CR9Shell {
                Eigen::Vector3d* J) const;
   double area() const { return area_; }  // reference mid-surface area
 
+  // Element averages (Σ_gp dA x / A) of the Cartesian strains and stress resultants of §4.5–4.6 in the
+  // Gauss points' local tangent bases, and the strain energy per unit area U/A (docs/theory.md §9.1).
+  struct Resultants {
+    Eigen::Vector3d membrane_strain, curvature, membrane_force, bending_moment;  // (11, 22, 12)
+    Eigen::Vector2d shear_strain, shear_force;                                    // (1, 2)
+    double energy_density = 0.0;
+  };
+  Resultants resultants(const Vec45& u, const Charts& charts) const;
+
   // Diagnostics for tests: local variables u_L = [t_i, θ_i] (absolute θ, §3.2), local force f_L and
   // local tangent k_L (§4.7) at u. Any pointer may be null. Returns U.
   double local(const Vec45& u, const Charts& charts, Vec45* uL, Vec45* fL, Mat45* kL) const;
@@ -118,6 +127,7 @@ class CR9Shell {
   Eigen::Matrix3d D1_;                  // plane-stress matrix (§4.6)
   std::array<GaussPoint, 9> gp_;
   Mat45 Kbs_;                           // constant bending + shear stiffness Σ dA (B_b^T M + B_s^T Q)
+  std::array<Eigen::Matrix<double, 5, 45>, 9> Bbs_;  // [B_b; B_s] per Gauss point (output only)
   Eigen::Matrix<double, 9, 9> m_;
   double area_ = 0.0;
 };

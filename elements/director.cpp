@@ -1,4 +1,4 @@
-// Director parametrisation by minor components: spec/element.md §2.1-2.3.
+// Director parametrisation by minor components: docs/theory.md §2.1-2.3.
 #include "elements/director.hpp"
 
 #include <cmath>
@@ -16,7 +16,7 @@ double dependent_component(const Eigen::Vector2d& q, const DirectorChart& ch) {
     std::ostringstream os;
     os << "director: minor components q = (" << q(0) << ", " << q(1) << ") give 1 - |q|^2 = " << r
        << " <= 0 (dependent component " << "XYZ"[ch.l]
-       << " lost); the Newton iterate overshot -- reject the iteration and cut the step (spec §2.1)";
+       << " lost); the Newton iterate overshot -- reject the iteration and cut the step (docs/theory.md §2.1)";
     throw std::domain_error(os.str());
   }
   return ch.s * std::sqrt(r);

@@ -1,4 +1,4 @@
-// Nodal director (unit normal) parametrised by its two minor components (spec/element.md §2).
+// Nodal director (unit normal) parametrised by its two minor components (docs/theory.md §2).
 //
 // A director p (unit 3-vector) is stored per node as q = (p_n, p_m), the two global components that
 // had the smallest magnitude when the node's chart was last selected; the dependent component is
@@ -9,7 +9,7 @@
 
 namespace shelldyn {
 
-// Choice record ch = (n, m, l, s) of spec/element.md §2.1: n < m are the global components stored
+// Choice record ch = (n, m, l, s) of docs/theory.md §2.1: n < m are the global components stored
 // as the nodal unknowns q = (p_n, p_m); l is the dependent (largest) component, s = sign(p_l).
 struct DirectorChart {
   int n = 0;

@@ -1,4 +1,4 @@
-// MITC9 tying data, spec/element.md §4.4.
+// MITC9 tying data, docs/theory.md §4.4.
 #include "elements/mitc9.hpp"
 
 #include <cmath>

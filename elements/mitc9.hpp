@@ -1,4 +1,4 @@
-// MITC9 assumed covariant strain tying (Bucalem & Bathe 1993), spec/element.md §4.4 (a substitution
+// MITC9 assumed covariant strain tying (Bucalem & Bathe 1993), docs/theory.md §4.4 (a substitution
 // for the unreachable scheme of the paper's ref. [13], see §0).
 //
 // Three families of tying points in (xi, eta), a = 1/sqrt(3), b = sqrt(3/5):

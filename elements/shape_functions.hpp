@@ -1,5 +1,5 @@
 // Biquadratic Lagrange shape functions of the 9-node quadrilateral and 3x3 Gauss rule
-// (spec/element.md §1, §4.1). Node order (0-based index = node - 1):
+// (docs/theory.md §1, §4.1). Node order (0-based index = node - 1):
 //
 //      4 ---- 7 ---- 3        eta
 //      |             |         ^

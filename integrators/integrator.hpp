@@ -60,6 +60,9 @@ class Integrator {
 
   // External work done on the system since initialize(), evaluated consistently with the scheme.
   virtual double external_work() const = 0;
+  // Work dissipated by Rayleigh damping so far, Σ Δqᵀ C q̇ with the scheme's own velocity (docs/theory.md
+  // §8.5); H = K + V − W_ext + W_damp is then the conserved total. 0 for integrators that do not track it.
+  virtual double damping_work() const { return 0.0; }
 };
 
 }  // namespace shelldyn

@@ -32,7 +32,7 @@ class Assembler {
   Index num_dofs() const { return pattern_->n; }
   int num_elements() const { return static_cast<int>(dofs_.size()); }
 
-  // Global DOF indices of element e, node-major (spec/element.md §1 DOF order).
+  // Global DOF indices of element e, node-major (docs/theory.md §1 DOF order).
   const std::array<Index, kElementDofs>& element_dofs(int e) const { return dofs_[static_cast<size_t>(e)]; }
 
   // values[...] += Ke at the pattern positions of element e (values has pattern()->nnz() entries).

@@ -335,21 +335,31 @@ std::vector<BoundaryConditionSpec> parse_bcs(const Parser& p, const YAML::Node& 
   return bcs;
 }
 
-InitialVelocitySpec parse_initial_velocity(const Parser& p, const YAML::Node& n) {
-  p.check_keys(n, "initial_velocity", {"translation", "angular", "about"}, {});
+InitialVelocitySpec parse_initial_velocity(const Parser& p, const YAML::Node& n, const std::string& path,
+                                           const std::string& base_dir) {
+  p.check_keys(n, path, {"set", "translation", "angular", "about", "field"}, {});
   InitialVelocitySpec v;
   v.given = true;
-  v.where = p.where(n, "initial_velocity");
-  if (n["translation"]) v.translation = p.vec3(n["translation"], "initial_velocity.translation");
-  if (n["angular"]) v.angular = p.vec3(n["angular"], "initial_velocity.angular");
+  v.where = p.where(n, path);
+  if (n["set"]) v.set = p.name(n["set"], path + ".set");
+  if (n["field"]) {
+    for (const char* k : {"translation", "angular", "about"})
+      if (n[k]) p.fail(n[k], path + "." + k, "give either 'field' or a rigid motion (translation/angular/about), not both");
+    fs::path file(p.string(n["field"], path + ".field"));
+    if (file.is_relative()) file = fs::path(base_dir) / file;
+    v.field = file.lexically_normal().string();
+    return v;
+  }
+  if (n["translation"]) v.translation = p.vec3(n["translation"], path + ".translation");
+  if (n["angular"]) v.angular = p.vec3(n["angular"], path + ".angular");
   if (n["about"]) {
     const YAML::Node a = n["about"];
     if (a.IsScalar()) {
       if (a.Scalar() != "centroid")
-        p.fail(a, "initial_velocity.about", "expected 'centroid' or a point [x, y, z], got '" + a.Scalar() + "'");
+        p.fail(a, path + ".about", "expected 'centroid' or a point [x, y, z], got '" + a.Scalar() + "'");
     } else {
       v.about_centroid = false;
-      v.about = p.vec3(a, "initial_velocity.about");
+      v.about = p.vec3(a, path + ".about");
     }
   }
   return v;
@@ -398,23 +408,49 @@ std::vector<LoadSpec> parse_loads(const Parser& p, const YAML::Node& n) {
   for (size_t k = 0; k < n.size(); ++k) {
     const std::string path = "loads[" + std::to_string(k) + "]";
     const YAML::Node e = n[k];
-    p.check_keys(e, path, {"set", "type", "direction", "amplitude", "distribution", "function"},
-                 {"set", "type", "direction", "amplitude"});
+    if (!e.IsMap()) p.fail(e, path, "expected a mapping {set, type, ...}, got a " + node_kind(e));
+    if (!e["type"]) p.fail(e, path + ".type", "missing required key 'type' (force, moment, pressure, follower_pressure, body_force or gravity)");
     LoadSpec l;
+    l.type = static_cast<LoadType>(p.choice(
+        e["type"], path + ".type", {"force", "moment", "pressure", "follower_pressure", "body_force", "gravity"}));
+    const bool nodal = l.type == LoadType::Force || l.type == LoadType::Moment;
+    const bool pressure = l.type == LoadType::Pressure || l.type == LoadType::FollowerPressure;
+    if (nodal)
+      p.check_keys(e, path, {"set", "type", "direction", "amplitude", "distribution", "function"},
+                   {"set", "type", "direction", "amplitude"});
+    else if (pressure)
+      p.check_keys(e, path, {"set", "type", "amplitude", "function"}, {"type", "amplitude"});
+    else
+      p.check_keys(e, path, {"set", "type", "direction", "amplitude", "function"}, {"type", "direction", "amplitude"});
     l.where = p.where(e, path);
-    l.set = p.name(e["set"], path + ".set");
-    l.type = p.choice(e["type"], path + ".type", {"force", "moment"}) == 0 ? LoadType::Force : LoadType::Moment;
-    l.direction = p.vec3(e["direction"], path + ".direction");
-    if (l.direction.norm() == 0.0) p.fail(e["direction"], path + ".direction", "must not be the zero vector");
+    l.set = e["set"] ? p.name(e["set"], path + ".set") : std::string("all");
+    if (!pressure) {
+      l.direction = p.vec3(e["direction"], path + ".direction");
+      if (l.direction.norm() == 0.0) p.fail(e["direction"], path + ".direction", "must not be the zero vector");
+    }
     l.amplitude = p.number(e["amplitude"], path + ".amplitude");
     if (e["distribution"])
-      l.distribution = p.choice(e["distribution"], path + ".distribution", {"per_node", "edge_total"}) == 0
-                           ? LoadDistribution::PerNode
-                           : LoadDistribution::EdgeTotal;
+      l.distribution = static_cast<LoadDistribution>(
+          p.choice(e["distribution"], path + ".distribution", {"per_node", "edge_total", "per_length"}));
+    if (l.type == LoadType::Moment && l.distribution == LoadDistribution::PerLength)
+      p.fail(e["distribution"], path + ".distribution", "per_length applies to forces only (use per_node or edge_total)");
     if (e["function"]) l.function = parse_function(p, e["function"], path + ".function");
     loads.push_back(std::move(l));
   }
   return loads;
+}
+
+DampingSpec parse_damping(const Parser& p, const YAML::Node& n) {
+  p.check_keys(n, "damping", {"mass", "stiffness"}, {});
+  DampingSpec d;
+  d.where = p.where(n, "damping");
+  for (const char* key : {"mass", "stiffness"}) {
+    if (!n[key]) continue;
+    const double v = p.number(n[key], std::string("damping.") + key);
+    if (v < 0.0) p.fail(n[key], std::string("damping.") + key, "must be >= 0 (a negative coefficient would add energy)");
+    (std::string(key) == "mass" ? d.mass : d.stiffness) = v;
+  }
+  return d;
 }
 
 IntegratorSpec parse_integrator(const Parser& p, const YAML::Node& n) {
@@ -467,7 +503,7 @@ std::vector<MonitorSpec> parse_monitors(const Parser& p, const YAML::Node& n) {
   for (size_t k = 0; k < n.size(); ++k) {
     const std::string path = "monitors[" + std::to_string(k) + "]";
     const YAML::Node e = n[k];
-    p.check_keys(e, path, {"name", "set", "quantity"}, {"name", "set", "quantity"});
+    p.check_keys(e, path, {"name", "set", "quantity", "reduce", "axis"}, {"name", "set", "quantity"});
     MonitorSpec m;
     m.where = p.where(e, path);
     m.name = p.name(e["name"], path + ".name");
@@ -476,7 +512,22 @@ std::vector<MonitorSpec> parse_monitors(const Parser& p, const YAML::Node& n) {
     if (!names.insert(m.name).second) p.fail(e["name"], path + ".name", "monitor '" + m.name + "' is defined twice");
     m.set = p.name(e["set"], path + ".set");
     m.quantity = static_cast<MonitorQuantity>(
-        p.choice(e["quantity"], path + ".quantity", {"ux", "uy", "uz", "ur", "px", "py", "pz", "vx", "vy", "vz"}));
+        p.choice(e["quantity"], path + ".quantity",
+                 {"ux", "uy", "uz", "ur", "px", "py", "pz", "vx", "vy", "vz", "rx", "ry", "rz"}));
+    if (e["reduce"])
+      m.reduce = static_cast<MonitorReduce>(
+          p.choice(e["reduce"], path + ".reduce", {"none", "sum", "mean", "max", "min"}));
+    if (e["axis"]) {
+      const YAML::Node a = e["axis"];
+      if (m.quantity != MonitorQuantity::Ur)
+        p.fail(a, path + ".axis", "only quantity ur has an axis (remove 'axis' or use quantity: ur)");
+      p.check_keys(a, path + ".axis", {"point", "direction"}, {"point", "direction"});
+      m.has_axis = true;
+      m.axis_point = p.vec3(a["point"], path + ".axis.point");
+      m.axis_direction = p.vec3(a["direction"], path + ".axis.direction");
+      if (m.axis_direction.norm() == 0.0) p.fail(a["direction"], path + ".axis.direction", "must not be the zero vector");
+      m.axis_direction.normalize();
+    }
     monitors.push_back(std::move(m));
   }
   return monitors;
@@ -486,7 +537,7 @@ CaseSpec parse_document(const Parser& p, const YAML::Node& root, const std::stri
   if (!root.IsDefined() || root.IsNull()) p.fail(root, "", "the case file is empty (see apps/cases/ for examples)");
   p.check_keys(root, "",
                {"name", "description", "mesh", "material", "sets", "boundary_conditions", "initial_velocity", "loads",
-                "integrator", "time", "output", "monitors"},
+                "damping", "integrator", "time", "output", "monitors"},
                {"mesh", "material", "integrator", "time"});
   CaseSpec c;
   c.source = p.source();
@@ -504,8 +555,21 @@ CaseSpec parse_document(const Parser& p, const YAML::Node& root, const std::stri
   c.material = parse_material(p, root["material"]);
   if (root["sets"]) c.sets = parse_sets(p, root["sets"]);
   if (root["boundary_conditions"]) c.boundary_conditions = parse_bcs(p, root["boundary_conditions"]);
-  if (root["initial_velocity"]) c.initial_velocity = parse_initial_velocity(p, root["initial_velocity"]);
+  if (root["initial_velocity"]) {
+    const YAML::Node iv = root["initial_velocity"];
+    if (iv.IsSequence()) {
+      if (iv.size() == 0) p.fail(iv, "initial_velocity", "empty list (omit the key to start at rest)");
+      for (size_t k = 0; k < iv.size(); ++k) {
+        InitialVelocitySpec e = parse_initial_velocity(p, iv[k], "initial_velocity[" + std::to_string(k) + "]", base_dir);
+        if (k == 0) c.initial_velocity = std::move(e);
+        else c.initial_velocity_more.push_back(std::move(e));
+      }
+    } else {
+      c.initial_velocity = parse_initial_velocity(p, iv, "initial_velocity", base_dir);
+    }
+  }
   if (root["loads"]) c.loads = parse_loads(p, root["loads"]);
+  if (root["damping"]) c.damping = parse_damping(p, root["damping"]);
   c.integrator = parse_integrator(p, root["integrator"]);
   c.time = parse_time(p, root["time"]);
   if (root["output"]) c.output = parse_output(p, root["output"]);
@@ -521,15 +585,24 @@ const char* mesh_kind_name(const MeshSpec& mesh) {
   return names[mesh.index()];
 }
 
-const char* load_type_name(LoadType t) { return t == LoadType::Force ? "force" : "moment"; }
+const char* load_type_name(LoadType t) {
+  static const char* names[] = {"force", "moment", "pressure", "follower_pressure", "body_force", "gravity"};
+  return names[static_cast<int>(t)];
+}
 
 const char* load_distribution_name(LoadDistribution d) {
-  return d == LoadDistribution::PerNode ? "per_node" : "edge_total";
+  static const char* names[] = {"per_node", "edge_total", "per_length"};
+  return names[static_cast<int>(d)];
 }
 
 const char* monitor_quantity_name(MonitorQuantity q) {
-  static const char* names[] = {"ux", "uy", "uz", "ur", "px", "py", "pz", "vx", "vy", "vz"};
+  static const char* names[] = {"ux", "uy", "uz", "ur", "px", "py", "pz", "vx", "vy", "vz", "rx", "ry", "rz"};
   return names[static_cast<int>(q)];
+}
+
+const char* monitor_reduce_name(MonitorReduce r) {
+  static const char* names[] = {"none", "sum", "mean", "max", "min"};
+  return names[static_cast<int>(r)];
 }
 
 long long TimeSpec::num_steps() const {

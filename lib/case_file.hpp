@@ -22,13 +22,19 @@
 //     NAME: {point: [x,y,z], [tol]} | {box: [[xmin,ymin,zmin],[xmax,ymax,zmax]]}
 //         | {nodes: [i, ...]}  (0-based) | {union: [NAME, ...]}
 //   boundary_conditions: [{set, fix: [ux|uy|uz|px|py|pz|director, ...]}, ...]          optional
-//   initial_velocity: {[translation], [angular], [about: centroid | [x,y,z]]}             optional
-//   loads: [{set, type: force|moment, direction, amplitude, [distribution: per_node|edge_total],
-//            [function: {type: constant|ramp|hat|triangle|table, ...}]}, ...]           optional
+//   initial_velocity: {[set = all], [translation], [angular], [about: centroid | [x,y,z]] | [field: v.csv]}
+//                     or a list of such entries (later ones override earlier ones)         optional
+//   loads: [{set, type: force|moment, direction, amplitude, [distribution: per_node|edge_total|per_length],
+//            [function: {type: constant|ramp|hat|triangle|table, ...}]}
+//          | {[set = all], type: pressure|follower_pressure, amplitude, [function]}
+//          | {[set = all], type: body_force|gravity, direction, amplitude, [function]}, ...]   optional
+//   damping: {[mass = 0], [stiffness = 0]}                                             optional
+// The full reference with types, defaults and units is docs/manual.md.
 //   integrator: {name, ...settings}    settings kept as ordered (key, scalar text) pairs
 //   time: {dt, t_end, [output_interval = dt]}
 //   output: {[vtu = true], [vtu_every = 10], [history = true]}                           optional
-//   monitors: [{name, set, quantity: ux|uy|uz|ur|px|py|pz|vx|vy|vz}, ...]                 optional
+//   monitors: [{name, set, quantity: ux|uy|uz|ur|px|py|pz|vx|vy|vz|rx|ry|rz, [reduce: none|sum|mean|max|min],
+//               [axis: {point, direction}]}, ...]                                         optional
 //
 // Errors: std::runtime_error with one line "FILE:LINE: key.path: reason (how to fix)".
 // Units: whatever consistent system the file uses; nothing is scaled.
@@ -104,17 +110,27 @@ struct BoundaryConditionSpec {
   std::string where;  // "FILE:LINE: boundary_conditions[k]"
 };
 
+// Rigid field v = translation + ω × (X − about), ṗ = ω × p on the nodes of `set`, or (with `field`) the
+// velocities of a CSV file "node,vx,vy,vz[,pdx,pdy,pdz]" (0-based nodes; director rates optional, projected
+// on the tangent plane of p). Later entries of a list override earlier ones on shared nodes.
 struct InitialVelocitySpec {
   bool given = false;  // false: the body starts at rest
+  std::string set = "all";
+  std::string field;   // absolute path of a CSV velocity field; empty: rigid field
   Eigen::Vector3d translation = Eigen::Vector3d::Zero();
   Eigen::Vector3d angular = Eigen::Vector3d::Zero();
-  bool about_centroid = true;  // true: about = centroid of the nodes
+  bool about_centroid = true;  // true: about = centroid of the set's nodes
   Eigen::Vector3d about = Eigen::Vector3d::Zero();
   std::string where;
 };
 
-enum class LoadType { Force, Moment };
-enum class LoadDistribution { PerNode, EdgeTotal };
+// force, moment: on the nodes of a node set. pressure (dead), follower_pressure: force per area on the
+// elements of an element set (or of the elements whose 9 nodes are in a node set), along the normal.
+// body_force: force per volume; gravity: acceleration (body force rho*g). docs/theory.md §8.
+enum class LoadType { Force, Moment, Pressure, FollowerPressure, BodyForce, Gravity };
+// per_node: the vector on every node; edge_total: the vector is the total, spread consistently over the
+// set's element edges; per_length: the vector is a force per unit length on those edges.
+enum class LoadDistribution { PerNode, EdgeTotal, PerLength };
 const char* load_type_name(LoadType t);
 const char* load_distribution_name(LoadDistribution d);
 
@@ -126,6 +142,13 @@ struct LoadSpec {
   LoadDistribution distribution = LoadDistribution::PerNode;
   TimeFunction function;  // default constant
   std::string where;      // "FILE:LINE: loads[k]"
+};
+
+// Rayleigh damping C = mass * M_0 + stiffness * K_0 (docs/theory.md §8.5); both 0: none.
+struct DampingSpec {
+  double mass = 0.0;       // a_M [1/time]
+  double stiffness = 0.0;  // a_K [time]
+  std::string where;
 };
 
 struct IntegratorSpec {
@@ -148,13 +171,20 @@ struct OutputSpec {
   bool history = true;
 };
 
-enum class MonitorQuantity { Ux, Uy, Uz, Ur, Px, Py, Pz, Vx, Vy, Vz };
+// Rx, Ry, Rz: reaction forces at constrained DOFs (docs/theory.md §9.2).
+enum class MonitorQuantity { Ux, Uy, Uz, Ur, Px, Py, Pz, Vx, Vy, Vz, Rx, Ry, Rz };
 const char* monitor_quantity_name(MonitorQuantity q);
+// None: the set must hold exactly one node; otherwise a reduction over the set's nodes.
+enum class MonitorReduce { None, Sum, Mean, Max, Min };
+const char* monitor_reduce_name(MonitorReduce r);
 
 struct MonitorSpec {
   std::string name;
-  std::string set;  // must resolve to exactly one node
+  std::string set;
   MonitorQuantity quantity = MonitorQuantity::Ux;
+  MonitorReduce reduce = MonitorReduce::None;
+  bool has_axis = false;  // ur about the axis through axis_point along axis_direction (else: from the origin)
+  Eigen::Vector3d axis_point = Eigen::Vector3d::Zero(), axis_direction = Eigen::Vector3d::UnitZ();
   std::string where;
 };
 
@@ -168,8 +198,10 @@ struct CaseSpec {
   CaseMaterial material;
   std::vector<SetSpec> sets;
   std::vector<BoundaryConditionSpec> boundary_conditions;
-  InitialVelocitySpec initial_velocity;
+  InitialVelocitySpec initial_velocity;                 // the mapping form, or the first entry of the list form
+  std::vector<InitialVelocitySpec> initial_velocity_more;  // further entries of the list form
   std::vector<LoadSpec> loads;
+  DampingSpec damping;
   IntegratorSpec integrator;
   TimeSpec time;
   OutputSpec output;

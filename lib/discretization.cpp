@@ -1,10 +1,13 @@
 #include "lib/discretization.hpp"
 
+#include "lib/surface_loads.hpp"
+
 #include "lib/gmsh_reader.hpp"
 #include "lib/mesh_generators.hpp"
 #include "lib/nodal_normals.hpp"
 
 #include <algorithm>
+#include <fstream>
 #include <array>
 #include <functional>
 #include <cmath>
@@ -43,6 +46,45 @@ const std::vector<int>& find_set(const Mesh& mesh, const std::string& name, cons
     fail(where, "unknown set '" + name + "' (available: " + available_sets(mesh) +
                     "; define it under 'sets:')");
   return it->second;
+}
+
+// A CSV velocity field "node,vx,vy,vz[,pdx,pdy,pdz]" (header line, 0-based node indices): node -> (v, ṗ).
+std::map<int, Eigen::Matrix<double, 6, 1>> read_velocity_field(const std::string& path, int num_nodes,
+                                                               const std::string& where) {
+  std::ifstream in(path);
+  if (!in) fail(where, "cannot open the velocity field '" + path + "' (check the path; relative to the case file)");
+  std::string line;
+  std::getline(in, line);
+  const bool with_director = std::count(line.begin(), line.end(), ',') >= 6;
+  if (line.rfind("node", 0) != 0)
+    fail(where, path + ":1: expected the header 'node,vx,vy,vz' or 'node,vx,vy,vz,pdx,pdy,pdz'");
+  std::map<int, Eigen::Matrix<double, 6, 1>> out;
+  for (int lineno = 2; std::getline(in, line); ++lineno) {
+    if (line.empty()) continue;
+    std::replace(line.begin(), line.end(), ',', ' ');
+    std::istringstream is(line);
+    long long node = -1;
+    Eigen::Matrix<double, 6, 1> v = Eigen::Matrix<double, 6, 1>::Zero();
+    is >> node >> v[0] >> v[1] >> v[2];
+    if (with_director) is >> v[3] >> v[4] >> v[5];
+    if (!is || node < 0 || node >= num_nodes || !v.allFinite())
+      fail(where, path + ":" + std::to_string(lineno) + ": expected a node index in [0, " + std::to_string(num_nodes) +
+                      ") and " + (with_director ? "6" : "3") + " finite numbers");
+    out[static_cast<int>(node)] = v;
+  }
+  return out;
+}
+
+// Elements a distributed load acts on: the element set `name`, else the elements whose nine nodes all
+// belong to the node set `name`.
+std::vector<int> find_elements(const Mesh& mesh, const std::string& name, const std::string& where) {
+  auto it = mesh.element_sets.find(name);
+  if (it != mesh.element_sets.end()) return it->second;
+  std::vector<int> elements = elements_within(mesh, find_set(mesh, name, where));
+  if (elements.empty())
+    fail(where, "no element has all its 9 nodes in set '" + name +
+                    "' (a pressure or body force needs a set covering whole elements, e.g. 'all' or a box)");
+  return elements;
 }
 
 // Adds the case's sets to mesh.node_sets. Unions may refer to sets defined later in the file, so sets
@@ -130,7 +172,7 @@ void resolve_case_sets(const CaseSpec& spec, Mesh& mesh, double mesh_size) {
 }
 
 // Consistent nodal weights of a uniform line load on the quadratic edges that lie entirely in
-// `nodes` (element.md §4.1 shape functions restricted to an edge): w_k = ∫ N_k |dX/ds| ds, normalised
+// `nodes` (docs/theory.md §4.1 shape functions restricted to an edge): w_k = ∫ N_k |dX/ds| ds, normalised
 // to sum 1. A straight edge with a centred mid-node gets 1/6, 4/6, 1/6 of its length share.
 std::map<int, double> edge_weights(const Mesh& mesh, const std::vector<int>& nodes, const std::string& where) {
   static const int kEdges[4][3] = {{0, 4, 1}, {1, 5, 2}, {2, 6, 3}, {3, 7, 0}};  // corner, mid, corner
@@ -214,7 +256,7 @@ Discretization build_discretization(const CaseSpec& spec) {
 
   resolve_case_sets(spec, mesh, d.mesh_size);
 
-  // Boundary conditions (element.md §2.3 item 2): recorded by meaning, resolved for the initial charts.
+  // Boundary conditions (docs/theory.md §2.3 item 2): recorded by meaning, resolved for the initial charts.
   d.dofs = DofMap(n);
   for (const auto& bc : spec.boundary_conditions)
     for (int node : find_set(mesh, bc.set, bc.where + ".set"))
@@ -235,24 +277,42 @@ Discretization build_discretization(const CaseSpec& spec) {
     fail(spec.boundary_conditions.empty() ? spec.source : spec.boundary_conditions.front().where, e.what());
   }
 
-  // Initial velocity: rigid-body field v = v0 + ω × (X − about), ṗ = ω × p (benchmarks.md §6).
+  // Initial velocity (docs/manual.md §2.6): rigid-body fields v = v0 + ω × (X − about), ṗ = ω × p
+  // (docs/benchmarks.md §6) on sets, or nodal values from a CSV file; later entries override earlier ones.
   d.initial_velocity = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(n) * kDofsPerNode);
-  const InitialVelocitySpec& iv = spec.initial_velocity;
-  if (iv.given) {
-    Vec3 about = iv.about;
-    if (iv.about_centroid) {
-      about.setZero();
-      for (const Vec3& x : mesh.X) about += x;
-      about /= n;
-    }
-    const double scale = iv.translation.norm() + iv.angular.norm() * std::max(d.mesh_size, 1.0);
-    for (int i = 0; i < n; ++i) {
-      const size_t si = static_cast<size_t>(i);
-      const Vec3 v = iv.translation + iv.angular.cross(mesh.X[si] - about);
-      const Eigen::Vector2d qdot = chart_coordinates(iv.angular.cross(d.normals[si]), d.charts[si]);
-      const Eigen::Index base = static_cast<Eigen::Index>(DofMap::dof(i, 0));
-      d.initial_velocity.segment<3>(base) = v;
-      d.initial_velocity.segment<2>(base + 3) = qdot;
+  std::vector<const InitialVelocitySpec*> parts;
+  if (spec.initial_velocity.given) parts.push_back(&spec.initial_velocity);
+  for (const auto& e : spec.initial_velocity_more) parts.push_back(&e);
+  for (const InitialVelocitySpec* ivp : parts) {
+    const InitialVelocitySpec& iv = *ivp;
+    const std::vector<int>& nodes = find_set(mesh, iv.set, iv.where + ".set");
+    double scale = 0.0;
+    if (!iv.field.empty()) {
+      for (const auto& [node, vel] : read_velocity_field(iv.field, n, iv.where + ".field")) {
+        if (!std::binary_search(nodes.begin(), nodes.end(), node)) continue;
+        const size_t si = static_cast<size_t>(node);
+        const Eigen::Index base = static_cast<Eigen::Index>(DofMap::dof(node, 0));
+        const Vec3 pdot = vel.tail<3>() - vel.tail<3>().dot(d.normals[si]) * d.normals[si];  // tangent to p
+        d.initial_velocity.segment<3>(base) = vel.head<3>();
+        d.initial_velocity.segment<2>(base + 3) = chart_coordinates(pdot, d.charts[si]);
+        scale = std::max(scale, vel.norm());
+      }
+    } else {
+      Vec3 about = iv.about;
+      if (iv.about_centroid) {
+        about.setZero();
+        for (int i : nodes) about += mesh.X[static_cast<size_t>(i)];
+        about /= static_cast<double>(nodes.size());
+      }
+      scale = iv.translation.norm() + iv.angular.norm() * std::max(d.mesh_size, 1.0);
+      for (int i : nodes) {
+        const size_t si = static_cast<size_t>(i);
+        const Vec3 v = iv.translation + iv.angular.cross(mesh.X[si] - about);
+        const Eigen::Vector2d qdot = chart_coordinates(iv.angular.cross(d.normals[si]), d.charts[si]);
+        const Eigen::Index base = static_cast<Eigen::Index>(DofMap::dof(i, 0));
+        d.initial_velocity.segment<3>(base) = v;
+        d.initial_velocity.segment<2>(base + 3) = qdot;
+      }
     }
     // A prescribed DOF cannot start moving: refuse instead of silently zeroing the user's field.
     for (Index dof : d.dofs.constrained_dofs()) {
@@ -269,34 +329,69 @@ Discretization build_discretization(const CaseSpec& spec) {
   // Loads.
   d.loads_end = 0.0;
   for (const LoadSpec& l : spec.loads) {
-    const std::vector<int>& nodes = find_set(mesh, l.set, l.where + ".set");
     const Vec3 vec = l.amplitude * l.direction;
-    if (l.distribution == LoadDistribution::PerNode) {
+    d.loads_end = std::max(d.loads_end, l.function.end_of_support());
+    if (l.type != LoadType::Force && l.type != LoadType::Moment) {  // distributed loads (docs/theory.md §8.2–8.4)
+      const std::vector<int> elements = find_elements(mesh, l.set, l.where + ".set");
+      if (l.type == LoadType::FollowerPressure) {
+        d.follower_pressures.push_back({elements, l.amplitude, l.function});
+        continue;
+      }
+      const std::map<int, Vec3> f =
+          l.type == LoadType::Pressure ? dead_pressure_forces(mesh, elements, l.amplitude)
+          : l.type == LoadType::BodyForce
+              ? body_forces(mesh, elements, vec, spec.material.thickness)
+              : body_forces(mesh, elements, spec.material.rho * vec, spec.material.thickness);
+      for (const auto& [node, force] : f) d.loads.push_back({node, LoadType::Force, force, l.function});
+      continue;
+    }
+    const std::vector<int>& nodes = find_set(mesh, l.set, l.where + ".set");
+    if (l.distribution == LoadDistribution::PerLength) {
+      const std::map<int, Vec3> f = edge_line_forces(mesh, nodes, vec);
+      if (f.empty())
+        fail(l.where + ".distribution", "distribution per_length needs element edges whose 3 nodes all belong to "
+                                        "the set; there are none (use a set along an edge)");
+      for (const auto& [node, force] : f) d.loads.push_back({node, LoadType::Force, force, l.function});
+    } else if (l.distribution == LoadDistribution::PerNode) {
       for (int node : nodes) d.loads.push_back({node, l.type, vec, l.function});
     } else {
       for (const auto& [node, w] : edge_weights(mesh, nodes, l.where + ".distribution"))
         d.loads.push_back({node, l.type, w * vec, l.function});
     }
-    d.loads_end = std::max(d.loads_end, l.function.end_of_support());
   }
 
   // Monitors.
   for (const MonitorSpec& m : spec.monitors) {
     const std::vector<int>& nodes = find_set(mesh, m.set, m.where + ".set");
-    if (nodes.size() != 1)
+    if (m.reduce == MonitorReduce::None && nodes.size() != 1)
       fail(m.where + ".set", "set '" + m.set + "' has " + std::to_string(nodes.size()) +
-                                 " nodes, a monitor needs exactly one (define a set with 'point:')");
-    if (m.quantity == MonitorQuantity::Ur &&
-        mesh.X[static_cast<size_t>(nodes[0])].norm() <= 1e-12 * std::max(d.mesh_size, 1.0))
-      fail(m.where + ".quantity", "ur is undefined at a node at the origin (use ux, uy or uz)");
-    d.monitors.push_back({m.name, nodes[0], m.quantity});
+                                 " nodes, a monitor needs exactly one (define a set with 'point:', or add reduce: sum|mean|max|min)");
+    for (int node : nodes) {
+      const Vec3& X = mesh.X[static_cast<size_t>(node)];
+      const Vec3 r = m.has_axis ? Vec3((X - m.axis_point) - (X - m.axis_point).dot(m.axis_direction) * m.axis_direction) : X;
+      if (m.quantity == MonitorQuantity::Ur && r.norm() <= 1e-12 * std::max(d.mesh_size, 1.0))
+        fail(m.where + ".quantity", std::string("ur is undefined at node ") + std::to_string(node) +
+                                        (m.has_axis ? ", which lies on the axis" : " at the origin (give an axis, or use ux, uy or uz)"));
+    }
+    Monitor mon;
+    mon.name = m.name;
+    mon.node = nodes[0];
+    mon.nodes = nodes;
+    mon.quantity = m.quantity;
+    mon.reduce = m.reduce;
+    mon.has_axis = m.has_axis;
+    mon.axis_point = m.axis_point;
+    mon.axis_direction = m.axis_direction;
+    d.monitors.push_back(std::move(mon));
   }
   return d;
 }
 
-double monitor_value(const Monitor& m, const Mesh& mesh, const Eigen::VectorXd& u, const Eigen::VectorXd& v,
-                     const std::vector<DirectorChart>& charts) {
-  const Eigen::Index base = static_cast<Eigen::Index>(DofMap::dof(m.node, 0));
+namespace {
+
+double node_value(const Monitor& m, int node, const Mesh& mesh, const Eigen::VectorXd& u, const Eigen::VectorXd& v,
+                  const std::vector<DirectorChart>& charts, const Eigen::VectorXd* reactions) {
+  const Eigen::Index base = static_cast<Eigen::Index>(DofMap::dof(node, 0));
   const int q = static_cast<int>(m.quantity);
   switch (m.quantity) {
     case MonitorQuantity::Ux:
@@ -304,21 +399,51 @@ double monitor_value(const Monitor& m, const Mesh& mesh, const Eigen::VectorXd& 
     case MonitorQuantity::Uz:
       return u[base + q - static_cast<int>(MonitorQuantity::Ux)];
     case MonitorQuantity::Ur: {
-      const Vec3& X = mesh.X[static_cast<size_t>(m.node)];
-      return u.segment<3>(base).dot(X) / X.norm();
+      const Vec3& X = mesh.X[static_cast<size_t>(node)];
+      const Vec3 r = m.has_axis ? Vec3((X - m.axis_point) - (X - m.axis_point).dot(m.axis_direction) * m.axis_direction) : X;
+      return u.segment<3>(base).dot(r) / r.norm();
     }
     case MonitorQuantity::Px:
     case MonitorQuantity::Py:
     case MonitorQuantity::Pz: {
       const Eigen::Vector2d qn = u.segment<2>(base + 3);
-      return director(qn, charts[static_cast<size_t>(m.node)])[q - static_cast<int>(MonitorQuantity::Px)];
+      return director(qn, charts[static_cast<size_t>(node)])[q - static_cast<int>(MonitorQuantity::Px)];
     }
     case MonitorQuantity::Vx:
     case MonitorQuantity::Vy:
     case MonitorQuantity::Vz:
       return v[base + q - static_cast<int>(MonitorQuantity::Vx)];
+    case MonitorQuantity::Rx:
+    case MonitorQuantity::Ry:
+    case MonitorQuantity::Rz:
+      return reactions ? (*reactions)[base + q - static_cast<int>(MonitorQuantity::Rx)]
+                       : std::numeric_limits<double>::quiet_NaN();
   }
   return 0.0;
+}
+
+}  // namespace
+
+double monitor_value(const Monitor& m, const Mesh& mesh, const Eigen::VectorXd& u, const Eigen::VectorXd& v,
+                     const std::vector<DirectorChart>& charts, const Eigen::VectorXd* reactions) {
+  if (m.reduce == MonitorReduce::None || m.nodes.empty()) return node_value(m, m.node, mesh, u, v, charts, reactions);
+  double acc = m.reduce == MonitorReduce::Max ? -std::numeric_limits<double>::infinity()
+               : m.reduce == MonitorReduce::Min ? std::numeric_limits<double>::infinity()
+                                                : 0.0;
+  for (int node : m.nodes) {
+    const double x = node_value(m, node, mesh, u, v, charts, reactions);
+    if (m.reduce == MonitorReduce::Max) acc = std::max(acc, x);
+    else if (m.reduce == MonitorReduce::Min) acc = std::min(acc, x);
+    else acc += x;
+  }
+  return m.reduce == MonitorReduce::Mean ? acc / double(m.nodes.size()) : acc;
+}
+
+bool monitors_need_reactions(const std::vector<Monitor>& monitors) {
+  for (const auto& m : monitors)
+    if (m.quantity == MonitorQuantity::Rx || m.quantity == MonitorQuantity::Ry || m.quantity == MonitorQuantity::Rz)
+      return true;
+  return false;
 }
 
 }  // namespace shelldyn

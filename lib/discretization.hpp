@@ -12,6 +12,7 @@
 #include "lib/case_file.hpp"
 #include "lib/dof_map.hpp"
 #include "lib/mesh.hpp"
+#include "lib/surface_loads.hpp"
 #include "lib/time_function.hpp"
 
 #include <Eigen/Core>
@@ -31,21 +32,26 @@ struct DiscreteLoad {
 
 struct Monitor {
   std::string name;
-  int node = 0;
+  int node = 0;             // the first (for reduce = none: the only) node of the set
+  std::vector<int> nodes;   // all nodes of the set
   MonitorQuantity quantity = MonitorQuantity::Ux;
+  MonitorReduce reduce = MonitorReduce::None;
+  bool has_axis = false;    // ur about an axis
+  Vec3 axis_point = Vec3::Zero(), axis_direction = Vec3::UnitZ();
 };
 
 struct Discretization {
   // The mesh, consistently oriented (orient_consistently), with the case's sets added to
   // mesh.node_sets next to the generator's / Gmsh's own sets.
   Mesh mesh;
-  std::vector<Vec3> normals;          // initial unit nodal normals p_i0 (element.md §2.4)
-  std::vector<DirectorChart> charts;  // select_chart(p_i0) per node (element.md §2.3)
+  std::vector<Vec3> normals;          // initial unit nodal normals p_i0 (docs/theory.md §2.4)
+  std::vector<DirectorChart> charts;  // select_chart(p_i0) per node (docs/theory.md §2.3)
   DofMap dofs{0};                     // boundary conditions recorded and resolved for `charts`
   // 5 per node: [v_X, v_Y, v_Z, q̇_1, q̇_2] with v = translation + ω × (X − about), q̇ = S (ω × p_i0)
   // (S = 2x3 selector of the chart's minor components n, m). Zero if the case has no initial velocity.
   Eigen::VectorXd initial_velocity;
-  std::vector<DiscreteLoad> loads;
+  std::vector<DiscreteLoad> loads;    // nodal forces/moments, incl. dead pressure, body force, edge loads
+  std::vector<FollowerPressure> follower_pressures;  // evaluated on the current geometry by the Model
   double loads_end = 0.0;             // all loads vanish for t >= loads_end (+inf if some never do; 0 if none)
   std::vector<Monitor> monitors;
   double surface_area = 0.0;
@@ -59,8 +65,12 @@ Discretization build_discretization(const CaseSpec& spec);
 Mesh build_mesh(const CaseSpec& spec);
 
 // Value of a monitor at a state given by the global vectors u = [d, q] and v = u̇ (5 per node) and
-// the current charts: ux..uz = d, ur = d·X0/|X0|, px..pz = p(q), vx..vz = ḋ.
+// the current charts: ux..uz = d, ur = d·e_r (e_r: unit vector from the axis, perpendicular to it, or
+// X0/|X0| without an axis), px..pz = p(q), vx..vz = ḋ, rx..rz = reactions (lib/reactions.hpp; NaN if
+// `reactions` is null), reduced over the set's nodes by m.reduce.
 double monitor_value(const Monitor& m, const Mesh& mesh, const Eigen::VectorXd& u, const Eigen::VectorXd& v,
-                     const std::vector<DirectorChart>& charts);
+                     const std::vector<DirectorChart>& charts, const Eigen::VectorXd* reactions = nullptr);
+// True if some monitor needs reaction forces.
+bool monitors_need_reactions(const std::vector<Monitor>& monitors);
 
 }  // namespace shelldyn

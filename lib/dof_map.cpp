@@ -52,14 +52,14 @@ void DofMap::resolve(const std::vector<DirectorChart>& charts) {
       case Fix::Uz:
         constrained_mask_[static_cast<size_t>(dof(c.node, static_cast<int>(c.what)))] = 1;
         break;
-      case Fix::Director:  // both minor components fixed => p fixed (spec/element.md §2.3, clamped)
+      case Fix::Director:  // both minor components fixed => p fixed (docs/theory.md §2.3, clamped)
         constrained_mask_[static_cast<size_t>(dof(c.node, 3))] = 1;
         constrained_mask_[static_cast<size_t>(dof(c.node, 4))] = 1;
         break;
       case Fix::Px:
       case Fix::Py:
       case Fix::Pz: {
-        // Symmetry plane with normal e_k: fix the q-entry holding p_k (spec/element.md §2.3 item 2).
+        // Symmetry plane with normal e_k: fix the q-entry holding p_k (docs/theory.md §2.3 item 2).
         // The slot depends on the node's chart, hence resolution per chart set.
         if (charts.size() != static_cast<size_t>(num_nodes_))
           throw std::logic_error("DofMap::resolve: director-component constraints need one chart per node");

@@ -1,5 +1,5 @@
-// Degrees of freedom: 5 per node, node-major, [d_X, d_Y, d_Z, q_1, q_2] (spec/element.md §2.1),
-// and Dirichlet constraints (spec/element.md §2.3 item 2).
+// Degrees of freedom: 5 per node, node-major, [d_X, d_Y, d_Z, q_1, q_2] (docs/theory.md §2.1),
+// and Dirichlet constraints (docs/theory.md §2.3 item 2).
 //
 // Constraints are stored by meaning and resolved to DOF indices for the current director charts:
 // fixing the director component p_k means fixing the q-entry that holds p_k, which moves when a chart

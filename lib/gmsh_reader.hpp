@@ -4,7 +4,7 @@
 // points, curves, surfaces; volumes are parsed and ignored); $Nodes (entity blocks, optional
 // parametric coordinates, sparse node tags); $Elements with types 10 (quad9: the shell mesh), and
 // 15 (point), 1 (line2), 8 (line3) which only serve physical groups. Other sections are skipped.
-// Gmsh's type-10 node order is the order of lib/mesh.hpp (spec/element.md §1), so connectivity is
+// Gmsh's type-10 node order is the order of lib/mesh.hpp (docs/theory.md §1), so connectivity is
 // copied as is.
 //
 // Result:

@@ -21,7 +21,7 @@ struct HistoryRow {
   long long step = 0;
   double t = 0, dt = 0;
   double kinetic = 0, strain = 0, external_work = 0, total = 0, rel_drift = 0;
-  Eigen::Vector3d L = Eigen::Vector3d::Zero();  // linear momentum (element.md §5.4)
+  Eigen::Vector3d L = Eigen::Vector3d::Zero();  // linear momentum (docs/theory.md §5.4)
   Eigen::Vector3d J = Eigen::Vector3d::Zero();  // angular momentum about the origin, director term included
   long long nonlinear_iters = 0, linear_setups = 0;
   double wall_s = 0;

@@ -1,6 +1,6 @@
 // Back-ends of lib/linear_solver.hpp. See the header for the contract; the numbers behind the
 // choices (AMD everywhere, supernodal CHOLMOD by default, KLU re-pivot threshold) are in
-// spec/stack.md §§3.2, 5.
+// docs/dependencies.md §§3.2, 5.
 #include "lib/linear_solver.hpp"
 
 #include "lib/profile.hpp"
@@ -338,7 +338,7 @@ class KluSolver final : public LinearSolver {
  public:
   KluSolver() {
     klu_l_defaults(&common_);
-    common_.ordering = 0;  // AMD (stack.md §5.4)
+    common_.ordering = 0;  // AMD (docs/dependencies.md §5.4)
   }
   ~KluSolver() override { release(); }
   KluSolver(const KluSolver&) = delete;

@@ -1,6 +1,6 @@
 // Sparse direct solvers for the symmetric systems of the project (tangents K̄, mass matrices, IDA and
 // ARKODE iteration matrices), behind one small interface: analyse once per pattern, factorize per
-// Newton setup, solve per iteration (architecture.md §4.4, spec/stack.md §5).
+// Newton setup, solve per iteration (architecture.md §4.4, docs/dependencies.md §5).
 //
 // Input contract (lib/sparse_matrix.hpp): square CSC with 64-bit indices, FULL storage (both
 // triangles), row indices sorted within each column, no duplicates. Each back-end reads what it
@@ -12,16 +12,16 @@
 //                   PERMANENTLY to simplicial LDLᵀ (re-analysis once; visible as an extra count in
 //                   stats().analyses) and retries. Rationale: a tangent that was indefinite once
 //                   (buckling, snap-through) tends to stay near-indefinite, and flip-flopping would
-//                   re-analyse every time. LDLᵀ has no pivoting (stack.md §5.3): a zero pivot or a
+//                   re-analyse every time. LDLᵀ has no pivoting (docs/dependencies.md §5.3): a zero pivot or a
 //                   non-finite factor throws. Supernodal speed depends on BLAS; with OpenBLAS set
-//                   OPENBLAS_NUM_THREADS=1 on small shared machines (stack.md §1.1).
+//                   OPENBLAS_NUM_THREADS=1 on small shared machines (docs/dependencies.md §1.1).
 //   - "eigen-ldlt": Eigen::SimplicialLDLT on an Eigen::Map of the arrays, lower triangle, AMD.
 //                   LDLᵀ without pivoting: works on mildly indefinite matrices, throws on breakdown.
 //   - "klu":        KLU (klu_l_*), LU with partial pivoting, AMD ordering (ordering = 0, never the
-//                   COLAMD default, stack.md §5.4). First factorization klu_l_factor, then
+//                   COLAMD default, docs/dependencies.md §5.4). First factorization klu_l_factor, then
 //                   klu_l_refactor (reuses the pivot order); when the reciprocal pivot growth
 //                   estimate klu_l_rcond drops below eps^(2/3) a fresh klu_l_factor re-pivots
-//                   (same threshold as SUNDIALS' own KLU module, stack.md §3.2). Handles indefinite
+//                   (same threshold as SUNDIALS' own KLU module, docs/dependencies.md §3.2). Handles indefinite
 //                   matrices; slower than the other two on shell patterns.
 //
 // Errors: bad input (wrong size, unsorted pattern, non-finite values, pattern different from the

@@ -1,6 +1,6 @@
 // Mesh of 9-node quadrilateral shell elements: initial nodal coordinates, connectivity, named sets.
 //
-// Node order inside an element is Gmsh type 10 = VTK type 28 = spec/element.md §1:
+// Node order inside an element is Gmsh type 10 = VTK type 28 = docs/theory.md §1:
 //
 //      4 ---- 7 ---- 3        eta
 //      |             |         ^
@@ -9,7 +9,7 @@
 //      1 ---- 5 ---- 2
 //
 // (1-based in the picture; stored 0-based). Corners run counter-clockwise when seen from the side the
-// initial shell normal points to (spec/element.md §2.4 orientation requirement).
+// initial shell normal points to (docs/theory.md §2.4 orientation requirement).
 //
 // Units: whatever consistent unit system the case file uses; the mesh does not scale anything.
 // Ownership: a Mesh is a plain value; generators and readers return it by value.

@@ -1,11 +1,11 @@
-// Structured quad9 meshes (spec/benchmarks.md §§1.3, 2.3, 3.2, 4.4).
+// Structured quad9 meshes (docs/benchmarks.md §§1.3, 2.3, 3.2, 4.4).
 //
 // Every generator works on a grid of "half-cell" node indices (I, J): element (i, j) owns the nodes
 // (2i + dI_k, 2j + dJ_k) for its 9 local nodes k (Gmsh type-10 order). Shared nodes are merged by
 // construction through the index map (I, J) -> node, never by a coordinate tolerance search, and
 // every node is placed on the exact surface (mid-side and centre nodes included), not on chords.
 // The parameter direction I (-> xi) and J (-> eta) are chosen so that X,xi x X,eta points to the
-// documented normal side, i.e. corners run counter-clockwise seen from there (spec/element.md §2.4).
+// documented normal side, i.e. corners run counter-clockwise seen from there (docs/theory.md §2.4).
 #include "lib/mesh_generators.hpp"
 
 #include <algorithm>
@@ -22,7 +22,7 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
-// Half-cell offsets of the 9 local nodes (spec/element.md §1: (xi, eta) = (dI - 1, dJ - 1)).
+// Half-cell offsets of the 9 local nodes (docs/theory.md §1: (xi, eta) = (dI - 1, dJ - 1)).
 constexpr int kDI[9] = {0, 2, 2, 0, 1, 2, 1, 0, 1};
 constexpr int kDJ[9] = {0, 0, 2, 2, 0, 1, 2, 1, 1};
 
@@ -288,7 +288,7 @@ Mesh make_cylindrical_panel(double radius, double angle, double length, int n_ar
   require_count(gen, "n_axial", n_axial);
   if (!(std::isfinite(angle) && angle > 0.0 && angle < 2.0 * kPi))
     bad_parameter(gen, "parameter 'angle' = " + str(angle) + " rad is invalid; it must lie in (0, 2*pi)");
-  // Each element must be far from folded for the diagonal triad (spec/element.md §2.4).
+  // Each element must be far from folded for the diagonal triad (docs/theory.md §2.4).
   if (!(angle / n_arc < kPi))
     bad_parameter(gen, "each element spans angle/n_arc = " + str(angle / n_arc) +
                            " rad; it must be < pi: increase 'n_arc'");
@@ -301,7 +301,7 @@ Mesh make_cylindrical_panel(double radius, double angle, double length, int n_ar
   auto id = [ni](int I, int J) { return J * ni + I; };
   m.X.resize(static_cast<size_t>(ni) * nj);
   // I -> X (xi), J -> psi (eta): e_X x d/dpsi (0, cos psi, -sin psi) = (0, sin psi, cos psi), i.e.
-  // the outward radial direction, away from the axis at (x, 0, -R) (spec/benchmarks.md §2.3).
+  // the outward radial direction, away from the axis at (x, 0, -R) (docs/benchmarks.md §2.3).
   for (int J = 0; J < nj; ++J) {
     // psi = angle (2J - (nj-1)) / (2 (nj-1)): exact 0 at the apex and exactly antisymmetric.
     const double psi = angle * double(2 * J - (nj - 1)) / double(2 * (nj - 1));

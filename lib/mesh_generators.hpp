@@ -1,5 +1,5 @@
 // Built-in structured meshes of 9-node quadrilaterals with named node and element sets, matching the
-// geometry conventions of spec/benchmarks.md. Every generator returns consistently oriented elements
+// geometry conventions of docs/benchmarks.md. Every generator returns consistently oriented elements
 // (counter-clockwise seen from the documented outward normal side) and the sets "all" (nodes) and
 // "all" (elements). Invalid parameters (non-positive sizes or counts, hole angle out of range, ...)
 // throw std::invalid_argument naming the parameter and the accepted range.
@@ -18,20 +18,20 @@ namespace shelldyn {
 Mesh make_rectangle(double a, double b, int nx, int ny, double x0 = 0.0, double y0 = 0.0);
 
 // Union of axis-aligned rectangles on a grid of square cells of side `cell` in the plane Z = 0,
-// normal +Z (for the flying L-shaped plate, spec/benchmarks.md §1.3: cells {0,0,3,7} and {3,0,6,3}
+// normal +Z (for the flying L-shaped plate, docs/benchmarks.md §1.3: cells {0,0,3,7} and {3,0,6,3}
 // with cell = 1). Each rectangle is {i0, j0, i1, j1} in cell units (i1 > i0, j1 > j0); rectangles
 // must not overlap and must form one edge-connected region. One element per cell; shared nodes merged.
 // Node sets: "boundary" (all nodes on the outer boundary).
 Mesh make_cell_union(const std::vector<std::array<int, 4>>& rectangles, double cell = 1.0);
 
-// Cylindrical panel (spec/benchmarks.md §2.3): axis along X, X in [0, length],
+// Cylindrical panel (docs/benchmarks.md §2.3): axis along X, X in [0, length],
 // Y = R sin(psi), Z = R cos(psi) - R, psi in [-angle/2, +angle/2]; n_arc elements along psi,
 // n_axial along X; normal points away from the axis (+Z at the apex line).
 // Node sets: "x0" (X = 0), "x1" (X = length), "arc_min" (psi = -angle/2), "arc_max" (psi = +angle/2),
 // "corner_x0_arcmin", "corner_x0_arcmax", "corner_x1_arcmin", "corner_x1_arcmax".
 Mesh make_cylindrical_panel(double radius, double angle, double length, int n_arc, int n_axial);
 
-// Hemisphere with a polar hole (spec/benchmarks.md §§3, 4.4): pole on +Z,
+// Hemisphere with a polar hole (docs/benchmarks.md §§3, 4.4): pole on +Z,
 // X = R sin(chi) cos(phi), Y = R sin(chi) sin(phi), Z = R cos(chi), chi in [hole, 90 deg].
 // quarter = true: phi in [0, 90 deg], n x n elements; quarter = false: phi in [0, 360 deg), 4n x n
 // elements (n per quarter in each direction). Normal points outward (radial).

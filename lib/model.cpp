@@ -197,6 +197,7 @@ void Model::inertial(const Eigen::VectorXd& u, const Eigen::VectorXd& v, const s
     elements_[static_cast<size_t>(e)].inertial(ue, ve, element_charts(e, charts), &fe);
     assembler_.add_vector(e, fe, Fm);
   });
+  if (has_damping()) add_damping(v, Fm);
 }
 
 void Model::inertia_force(const Eigen::VectorXd& u, const Eigen::VectorXd& v, const Eigen::VectorXd& a,
@@ -215,6 +216,7 @@ void Model::inertia_force(const Eigen::VectorXd& u, const Eigen::VectorXd& v, co
     fe.noalias() += me * ae;
     assembler_.add_vector(e, fe, out);
   });
+  if (has_damping()) add_damping(v, out);
 }
 
 void Model::external(double t, const Eigen::VectorXd& u, const std::vector<DirectorChart>& charts,
@@ -227,7 +229,7 @@ void Model::external(double t, const Eigen::VectorXd& u, const std::vector<Direc
     if (load.kind == NodalLoad::Kind::Force) {
       for (int c = 0; c < 3; ++c) F[DofMap::dof(load.node, c)] += f * load.vector[c];
     } else {
-      // Dead moment m: δW = m·δφ with δp = δφ × p, so f_q = A1ᵀ (m × p) (spec/element.md §2.3 item 3).
+      // Dead moment m: δW = m·δφ with δp = δφ × p, so f_q = A1ᵀ (m × p) (docs/theory.md §2.3 item 3).
       const Eigen::Vector2d q = u.segment<2>(DofMap::dof(load.node, 3));
       const DirectorChart& ch = charts[static_cast<size_t>(load.node)];
       const Eigen::Vector2d fq = director_A1(q, ch).transpose() * (f * load.vector).cross(shelldyn::director(q, ch));
@@ -235,6 +237,7 @@ void Model::external(double t, const Eigen::VectorXd& u, const std::vector<Direc
       F[DofMap::dof(load.node, 4)] += fq[1];
     }
   }
+  if (!follower_.empty()) add_follower_pressures(follower_, mesh_, assembler_, t, u, F, nullptr, false);
 }
 
 void Model::add_load_stiffness(double t, const Eigen::VectorXd& u, const std::vector<DirectorChart>& charts,
@@ -252,6 +255,7 @@ void Model::add_load_stiffness(double t, const Eigen::VectorXd& u, const std::ve
         K.values[static_cast<size_t>(assembler_.find(DofMap::dof(load.node, 3 + a), DofMap::dof(load.node, 3 + b)))] -=
             dF(a, b);
   }
+  if (!follower_.empty()) add_follower_pressures(follower_, mesh_, assembler_, t, u, nullptr, &K, !full_load_tangent_);
 }
 
 Invariants Model::invariants(const State& s) const {
@@ -298,7 +302,40 @@ Invariants Model::invariants(const State& s) const {
 double Model::loads_end() const {
   double end = 0.0;
   for (const auto& load : loads_) end = std::max(end, load.function.end_of_support());
+  for (const auto& load : follower_) end = std::max(end, load.function.end_of_support());
   return end;
+}
+
+void Model::set_rayleigh_damping(double mass_coefficient, double stiffness_coefficient) {
+  if (!(mass_coefficient >= 0.0) || !(stiffness_coefficient >= 0.0))
+    throw std::invalid_argument("Rayleigh damping coefficients must be >= 0");
+  damping_ = SparseMatrix{};
+  if (mass_coefficient == 0.0 && stiffness_coefficient == 0.0) return;
+  // C = a_M M_0 + a_K K_0 at the reference state (docs/theory.md §8.5).
+  const State s0 = initial_state();
+  SparseMatrix M = make_matrix(), K = make_matrix();
+  mass(s0.u, s0.charts, M);
+  internal(s0.u, s0.charts, nullptr, &K);
+  SparseMatrix C = make_matrix();
+  for (size_t k = 0; k < C.values.size(); ++k)
+    C.values[k] = mass_coefficient * M.values[k] + stiffness_coefficient * K.values[k];
+  damping_ = std::move(C);
+}
+
+void Model::damping_force(const Eigen::VectorXd& v, double* out) const {
+  std::fill(out, out + num_dofs(), 0.0);
+  if (has_damping()) add_damping(v, out);
+}
+
+void Model::add_damping(const Eigen::VectorXd& v, double* out) const {
+  Eigen::VectorXd cv(num_dofs());
+  multiply(damping_.view(), v.data(), cv.data());
+  for (Index i = 0; i < num_dofs(); ++i) out[i] += cv[i];
+}
+
+void Model::add_damping_matrix(double c, SparseMatrix& J) const {
+  if (!has_damping()) return;
+  for (size_t k = 0; k < J.values.size(); ++k) J.values[k] += c * damping_.values[k];
 }
 
 double Model::chart_margin(const State& s) const {

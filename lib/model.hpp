@@ -1,4 +1,4 @@
-// The semi-discretization M(q) q̈ + F_m(q, q̇) + F_int(q) = F_ext(t)   (paper eq. 26; spec/element.md §5.3)
+// The semi-discretization M(q) q̈ + F_m(q, q̇) + F_int(q) = F_ext(t)   (paper eq. 26; docs/theory.md §5.3)
 // of a mesh of CR9 shell elements (architecture.md §4.2).
 //
 // The Model knows nothing about time integration: it evaluates forces, matrices, energies and momenta
@@ -18,6 +18,7 @@
 #include "lib/semi_discrete_system.hpp"
 #include "lib/sparse_matrix.hpp"
 #include "lib/state.hpp"
+#include "lib/surface_loads.hpp"
 #include "lib/time_function.hpp"
 
 #include <Eigen/Core>
@@ -28,7 +29,7 @@
 namespace shelldyn {
 
 // A load on one node: a dead force (global vector) or a dead moment m, whose generalised force on the
-// director unknowns is A1ᵀ (m × p) (spec/element.md §2.3 item 3), both scaled by f(t).
+// director unknowns is A1ᵀ (m × p) (docs/theory.md §2.3 item 3), both scaled by f(t).
 struct NodalLoad {
   enum class Kind { Force, Moment };
   int node = 0;
@@ -61,7 +62,7 @@ class Model final : public SemiDiscreteSystem {
   // F_int(q), K = ∂F_int/∂q (exact, symmetric), returns V = Σ U_e. F or K may be null.
   double internal(const Eigen::VectorXd& u, const std::vector<DirectorChart>& charts, double* F,
                   SparseMatrix* K) const override;
-  // Strain-averaged force F*_int,mid and its symmetric tangent K_mid (spec/element.md §6.3); returns V(u_np1).
+  // Strain-averaged force F*_int,mid and its symmetric tangent K_mid (docs/theory.md §6.3); returns V(u_np1).
   double algorithmic_internal(const Eigen::VectorXd& u_n, const Eigen::VectorXd& u_np1,
                               const std::vector<DirectorChart>& charts, double alpha_f, double xi, double* F,
                               SparseMatrix* K) const override;
@@ -81,6 +82,18 @@ class Model final : public SemiDiscreteSystem {
                           SparseMatrix& K) const override;
   Invariants invariants(const State& s) const override;
   double loads_end() const override;
+
+  // Distributed loads and damping (lib/surface_loads.hpp, docs/theory.md §8). Follower pressures act in
+  // external() and add_load_stiffness() (their tangent in full, or its symmetric part for symmetric
+  // solvers); Rayleigh damping C = a_M M_0 + a_K K_0 (reference state, assembled once) adds C v to
+  // inertial() and inertia_force().
+  void set_follower_pressures(std::vector<FollowerPressure> loads) { follower_ = std::move(loads); }
+  const std::vector<FollowerPressure>& follower_pressures() const { return follower_; }
+  void set_unsymmetric_load_stiffness(bool full) { full_load_tangent_ = full; }
+  void set_rayleigh_damping(double mass_coefficient, double stiffness_coefficient);
+  bool has_damping() const override { return !damping_.values.empty(); }
+  void damping_force(const Eigen::VectorXd& v, double* out) const override;
+  void add_damping_matrix(double c, SparseMatrix& J) const override;
 
   // ---- Embedded kinematics of the exactly conserving step em-exact (docs/theory/exact-energy-momentum.md) ----
   // y = (m ⊗ I₃) x: x, y hold one 3-vector per node; m = Σ_e ∫ N_i N_j dA (consistent scalar mass).
@@ -112,7 +125,7 @@ class Model final : public SemiDiscreteSystem {
   // Current director of node i.
   Vec3 director(const State& s, int node) const;
 
-  // Re-selects director charts between increments (spec/element.md §2.3), converting u, v, a, and
+  // Re-selects director charts between increments (docs/theory.md §2.3), converting u, v, a, and
   // re-resolves director constraints. Returns the number of nodes whose chart switched.
   int rechart(State& s, double hysteresis = 1.0) override;
   double chart_margin(const State& s) const override;
@@ -120,6 +133,7 @@ class Model final : public SemiDiscreteSystem {
  private:
   void gather(int e, const Eigen::VectorXd& global, CR9Shell::Vec45& ue) const;
   CR9Shell::Charts element_charts(int e, const std::vector<DirectorChart>& charts) const;
+  void add_damping(const Eigen::VectorXd& v, double* out) const;  // out += C v
 
   Mesh mesh_;
   std::vector<Vec3> normals_;
@@ -128,6 +142,9 @@ class Model final : public SemiDiscreteSystem {
   std::vector<NodalLoad> loads_;
   Assembler assembler_;
   std::vector<CR9Shell> elements_;
+  std::vector<FollowerPressure> follower_;
+  bool full_load_tangent_ = false;
+  SparseMatrix damping_;  // empty values: no damping
 
   // Per-step element state at u_n for algorithmic_internal() (CR9Shell::StepState): u_n is fixed during a
   // step's Newton iterations, so its frame, local increments and membrane products are computed at the

@@ -1,4 +1,4 @@
-// Initial nodal normals, orientation and area of quad9 meshes (spec/element.md §§1, 2.4, 3.1).
+// Initial nodal normals, orientation and area of quad9 meshes (docs/theory.md §§1, 2.4, 3.1).
 #include "lib/nodal_normals.hpp"
 
 #include <Eigen/Geometry>
@@ -12,7 +12,7 @@
 namespace shelldyn {
 namespace {
 
-// Natural coordinates of the 9 nodes (spec/element.md §1).
+// Natural coordinates of the 9 nodes (docs/theory.md §1).
 constexpr double kXi[9] = {-1, 1, 1, -1, 0, 1, 0, -1, 0};
 constexpr double kEta[9] = {-1, -1, 1, 1, -1, 0, 1, 0, 0};
 
@@ -78,14 +78,14 @@ std::vector<Vec3> initial_normals(const Mesh& mesh) {
     for (int k = 0; k < 9; ++k) {
       Vec3 g1, g2;
       tangents(mesh, el, kXi[k], kEta[k], g1, g2);
-      const Vec3 n = g1.cross(g2);  // paper eq. 7 / spec §2.4 step 1
+      const Vec3 n = g1.cross(g2);  // paper eq. 7 / docs/theory.md §2.4 step 1
       const double len = n.norm();
       // Relative test: |g1 x g2| against |g1||g2| (scale-free degeneracy check).
       if (!(len > 1e-12 * g1.norm() * g2.norm()) || !std::isfinite(len))
         throw std::invalid_argument("initial_normals: " + where(e, k, el[k]) +
                                     ": X,xi x X,eta vanishes (degenerate or collapsed element); fix the "
                                     "mesh geometry");
-      sum[static_cast<size_t>(el[k])] += n / len;  // normalise first (spec §2.4 recommendation)
+      sum[static_cast<size_t>(el[k])] += n / len;  // normalise first (docs/theory.md §2.4 recommendation)
       ++count[static_cast<size_t>(el[k])];
     }
   }
@@ -99,8 +99,8 @@ std::vector<Vec3> initial_normals(const Mesh& mesh) {
       throw std::invalid_argument("initial_normals: the element normals at mesh node " + std::to_string(i) +
                                   " cancel: adjacent elements are oriented oppositely (call "
                                   "orient_consistently() first) or the mesh is folded there (out of "
-                                  "scope, spec/element.md §2.4)");
-    sum[i] /= len;  // spec §2.4 step 2
+                                  "scope, docs/theory.md §2.4)");
+    sum[i] /= len;  // docs/theory.md §2.4 step 2
   }
   return sum;
 }
@@ -176,7 +176,7 @@ void check_orientation(const Mesh& mesh, const std::vector<Vec3>& normals) {
                                 " nodes; pass initial_normals(mesh)");
   for (int e = 0; e < mesh.num_elements(); ++e) {
     const Quad9& q = mesh.elements[static_cast<size_t>(e)];
-    // spec/element.md §3.1 (paper eqs. 3-6) at the initial geometry.
+    // docs/theory.md §3.1 (paper eqs. 3-6) at the initial geometry.
     const Vec3 a = mesh.X[static_cast<size_t>(q[2])] - mesh.X[static_cast<size_t>(q[0])];
     const Vec3 b = mesh.X[static_cast<size_t>(q[3])] - mesh.X[static_cast<size_t>(q[1])];
     const double la = a.norm(), lb = b.norm();
@@ -194,7 +194,7 @@ void check_orientation(const Mesh& mesh, const std::vector<Vec3>& normals) {
       if (!(r > 0.0)) {
         std::ostringstream os;
         os << "check_orientation: " << where(e, k, q[k]) << ": e_z0 . p_i0 = " << r
-           << " <= 0 (spec/element.md §2.4). The element is numbered clockwise with respect to the "
+           << " <= 0 (docs/theory.md §2.4). The element is numbered clockwise with respect to the "
               "nodal normal (call orient_consistently(), or reverse it) or the shell is folded / "
               "non-smooth there, which is out of scope";
         throw std::invalid_argument(os.str());

@@ -1,10 +1,10 @@
-// Initial nodal normals p_i0 and element orientation of a quad9 shell mesh (spec/element.md §2.4,
+// Initial nodal normals p_i0 and element orientation of a quad9 shell mesh (docs/theory.md §2.4,
 // paper eq. 7), plus the mid-surface area.
 //
-// Scope: smooth shells only (spec/element.md §2.4). Folded or non-smooth shells need the separate
+// Scope: smooth shells only (docs/theory.md §2.4). Folded or non-smooth shells need the separate
 // treatment of Li et al. 2018/2021 and are rejected by check_orientation().
 // All functions are pure functions of the mesh (no global state); errors are exceptions whose
-// message names the element (0-based index), the local node (1-based, spec/element.md §1 numbering)
+// message names the element (0-based index), the local node (1-based, docs/theory.md §1 numbering)
 // and the mesh node (0-based index).
 #pragma once
 
@@ -14,7 +14,7 @@
 
 namespace shelldyn {
 
-// spec/element.md §2.4: for each element e and each of its nodes i, n_e,i = X,xi x X,eta at the
+// docs/theory.md §2.4: for each element e and each of its nodes i, n_e,i = X,xi x X,eta at the
 // node's natural coordinates (quad9 geometry), normalised; at each mesh node the n_e,i of the adjacent
 // elements are summed and normalised again. Returns one unit vector per mesh node.
 // Throws std::invalid_argument if an element references a node index out of range, if X,xi x X,eta
@@ -31,7 +31,7 @@ std::vector<Vec3> initial_normals(const Mesh& mesh);
 // more than two elements (non-manifold), naming the elements involved.
 int orient_consistently(Mesh& mesh);
 
-// spec/element.md §2.4 orientation requirement: for every element the initial diagonal triad e_z0
+// docs/theory.md §2.4 orientation requirement: for every element the initial diagonal triad e_z0
 // (§3.1: a = X3 - X1, b = X4 - X2, e_x ∝ â - b̂, e_y ∝ â + b̂, e_z = e_x × e_y) must satisfy
 // e_z0 · p_i0 > 0 at all 9 nodes. Throws std::invalid_argument naming the first failing element and
 // node (with the value of e_z0 · p_i0), or a degenerate element (zero diagonal, or parallel diagonals).

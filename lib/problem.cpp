@@ -21,7 +21,9 @@ Model make_model(const Discretization& d, const CaseMaterial& material) {
     nl.function = l.function;
     loads.push_back(nl);
   }
-  return Model(d.mesh, d.normals, shell_material(material), d.dofs, std::move(loads));
+  Model model(d.mesh, d.normals, shell_material(material), d.dofs, std::move(loads));
+  model.set_follower_pressures(d.follower_pressures);
+  return model;
 }
 
 State Problem::initial_state() const {
@@ -36,6 +38,7 @@ Problem make_problem(CaseSpec spec) {
   p.disc = build_discretization(p.spec);
   try {
     p.model = std::make_unique<Model>(make_model(p.disc, p.spec.material));
+    p.model->set_rayleigh_damping(p.spec.damping.mass, p.spec.damping.stiffness);
   } catch (const std::exception& e) {
     throw std::runtime_error(p.spec.source + ": " + e.what());
   }

@@ -230,6 +230,9 @@ std::string run_json(const CaseSpec& c, const RunInfo& info) {
   }
   j.close_array();
   j.open_object("initial_velocity");
+  j.str("set", c.initial_velocity.set);
+  if (!c.initial_velocity.field.empty()) j.str("field", c.initial_velocity.field);
+  if (!c.initial_velocity_more.empty()) j.integer("further_entries", static_cast<long long>(c.initial_velocity_more.size()));
   j.vec3("translation", c.initial_velocity.translation);
   j.vec3("angular", c.initial_velocity.angular);
   if (c.initial_velocity.about_centroid)
@@ -254,6 +257,9 @@ std::string run_json(const CaseSpec& c, const RunInfo& info) {
     j.close_object();
   }
   j.close_array();
+  j.open_object("damping");
+  j.num("mass", c.damping.mass), j.num("stiffness", c.damping.stiffness);
+  j.close_object();
   j.open_object("integrator");
   j.str("name", c.integrator.name);
   for (const auto& [k, v] : c.integrator.settings) j.str(k, v);
@@ -269,6 +275,12 @@ std::string run_json(const CaseSpec& c, const RunInfo& info) {
   for (const auto& m : c.monitors) {
     j.open_object();
     j.str("name", m.name), j.str("set", m.set), j.str("quantity", monitor_quantity_name(m.quantity));
+    j.str("reduce", monitor_reduce_name(m.reduce));
+    if (m.has_axis) {
+      j.open_object("axis");
+      j.vec3("point", m.axis_point), j.vec3("direction", m.axis_direction);
+      j.close_object();
+    }
     j.close_object();
   }
   j.close_array();

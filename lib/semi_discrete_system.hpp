@@ -1,9 +1,9 @@
 // The interface every time integrator sees (architecture.md §1, §4.2): a semi-discrete second-order system
-//     M(q) q̈ + F_m(q, q̇) + F_int(q) = F_ext(t, q)          (paper eq. 26; spec/element.md §5.3)
+//     M(q) q̈ + F_m(q, q̇) + F_int(q) = F_ext(t, q)          (paper eq. 26; docs/theory.md §5.3)
 // on a fixed sparsity pattern, with Dirichlet constraints and per-node director charts.
 //
 // The shell Model implements it; tests implement it for small linear systems (e.g. the spring–mass
-// oscillator of spec/element.md §7 item 13) so that the integrators' code is checked on problems with
+// oscillator of docs/theory.md §7 item 13) so that the integrators' code is checked on problems with
 // exact answers. Evaluations write into caller-owned storage; matrices are unconstrained (the
 // integrator applies dofs() with apply_dirichlet).
 #pragma once
@@ -19,7 +19,7 @@
 namespace shelldyn {
 
 struct Invariants {
-  double kinetic = 0.0;                            // ½ q̇ᵀ M(q) q̇  (spec/element.md §5.4)
+  double kinetic = 0.0;                            // ½ q̇ᵀ M(q) q̇  (docs/theory.md §5.4)
   double strain = 0.0;                             // V(q)
   Eigen::Vector3d L = Eigen::Vector3d::Zero();     // linear momentum
   Eigen::Vector3d J = Eigen::Vector3d::Zero();     // angular momentum about the origin, director term included
@@ -37,7 +37,7 @@ class SemiDiscreteSystem {
   // F_int(q) and its exact symmetric tangent; returns V(q). F or K may be null.
   virtual double internal(const Eigen::VectorXd& u, const std::vector<DirectorChart>& charts, double* F,
                           SparseMatrix* K) const = 0;
-  // Strain-averaged force of spec/element.md §6.3 and its symmetric tangent; returns V(u_np1).
+  // Strain-averaged force of docs/theory.md §6.3 and its symmetric tangent; returns V(u_np1).
   virtual double algorithmic_internal(const Eigen::VectorXd& u_n, const Eigen::VectorXd& u_np1,
                                       const std::vector<DirectorChart>& charts, double alpha_f, double xi,
                                       double* F, SparseMatrix* K) const = 0;
@@ -54,11 +54,17 @@ class SemiDiscreteSystem {
   // K += −sym ∂F_ext/∂q (configuration-dependent loads); default: dead loads, nothing to add.
   virtual void add_load_stiffness(double /*t*/, const Eigen::VectorXd& /*u*/,
                                   const std::vector<DirectorChart>& /*charts*/, SparseMatrix& /*K*/) const {}
+  // Rayleigh damping C = a_M M_0 + a_K K_0 (docs/theory.md §8.5). Systems with damping include C q̇ in
+  // inertial() and inertia_force(); integrators add c·C to iteration matrices (c = ∂q̇/∂q of their
+  // scheme) and accumulate the dissipated work with damping_force(). Default: no damping.
+  virtual bool has_damping() const { return false; }
+  virtual void damping_force(const Eigen::VectorXd& /*v*/, double* /*out*/) const {}       // out = C v
+  virtual void add_damping_matrix(double /*c*/, SparseMatrix& /*J*/) const {}              // J += c C
   virtual Invariants invariants(const State& s) const = 0;
   // Time after which F_ext vanishes identically (+inf if never; 0 if there are no loads).
   virtual double loads_end() const = 0;
 
-  // Re-selects director charts between steps (spec/element.md §2.3), converting u, v, a so that p, ṗ, p̈
+  // Re-selects director charts between steps (docs/theory.md §2.3), converting u, v, a so that p, ṗ, p̈
   // are unchanged; returns the number of switched nodes. Systems without directors return 0.
   virtual int rechart(State& s, double hysteresis = 1.0) = 0;
   // How far each director may still turn before its chart should switch: min over nodes of

@@ -1,5 +1,5 @@
 // Compressed sparse column storage with 64-bit indices (= SUNDIALS' sunindextype on Debian 12,
-// spec/stack.md §2.3), so that arrays can be handed to KLU (klu_l_*), CHOLMOD (cholmod_l_*), Eigen
+// docs/dependencies.md §2.3), so that arrays can be handed to KLU (klu_l_*), CHOLMOD (cholmod_l_*), Eigen
 // (StorageIndex = int64_t) and SUNSparseMatrix without copies.
 //
 // Contract: square, full symmetric storage (both triangles), row indices sorted within each column,

@@ -1,5 +1,5 @@
 // Scalar load-amplitude functions of time f(t), used by the case file's `loads[].function`
-// (spec/benchmarks.md §1.2 hat, §3.1 triangle). All functions are 0 for t < 0 except `constant`.
+// (docs/benchmarks.md §1.2 hat, §3.1 triangle). All functions are 0 for t < 0 except `constant`.
 //
 // A TimeFunction is a small immutable value; construct it with the named factories, which validate
 // their parameters and throw std::invalid_argument naming the parameter and the accepted range.
@@ -19,9 +19,9 @@ class TimeFunction {
   static TimeFunction constant();
   // f(t) = min(t/t1, 1) for t >= 0, 0 for t < 0. Requires t1 > 0.
   static TimeFunction ramp(double t1);
-  // Symmetric hat of benchmarks.md §1.2: t/t1 on [0, t1], 2 - t/t1 on [t1, 2 t1], 0 after. t1 > 0.
+  // Symmetric hat of docs/benchmarks.md §1.2: t/t1 on [0, t1], 2 - t/t1 on [t1, 2 t1], 0 after. t1 > 0.
   static TimeFunction hat(double t1);
-  // Triangle of benchmarks.md §3.1: 0 -> 1 on [0, t_peak], 1 -> 0 on [t_peak, t_end], 0 after.
+  // Triangle of docs/benchmarks.md §3.1: 0 -> 1 on [0, t_peak], 1 -> 0 on [t_peak, t_end], 0 after.
   // Requires 0 < t_peak < t_end.
   static TimeFunction triangle(double t_peak, double t_end);
   // Piecewise linear through (t_k, f_k); constant (f_0 resp. f_last) beyond the ends. At least one
@@ -32,7 +32,7 @@ class TimeFunction {
 
   double operator()(double t) const;
   // Time after which f is identically 0, or +inf if it never vanishes for good. Loads whose
-  // functions have all ended leave the system free (benchmarks.md §0: H = K + V_int afterwards).
+  // functions have all ended leave the system free (docs/benchmarks.md §0: H = K + V_int afterwards).
   double end_of_support() const;
 
   Kind kind() const { return kind_; }

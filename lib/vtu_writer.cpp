@@ -63,8 +63,14 @@ void write_vectors(std::FILE* f, const char* name, const std::vector<Vec3>& v) {
 }
 
 void write_scalars(std::FILE* f, const ScalarField& s) {
-  std::fprintf(f, "        <DataArray type=\"Float64\" Name=\"%s\" format=\"ascii\">\n", xml_escape(s.name).c_str());
-  for (double v : s.values) std::fprintf(f, "          %.17g\n", v);
+  std::fprintf(f, "        <DataArray type=\"Float64\" Name=\"%s\" NumberOfComponents=\"%d\" format=\"ascii\">\n",
+               xml_escape(s.name).c_str(), s.components);
+  const size_t nc = static_cast<size_t>(s.components);
+  for (size_t k = 0; k < s.values.size(); k += nc) {
+    std::fprintf(f, "         ");
+    for (size_t c = 0; c < nc; ++c) std::fprintf(f, " %.17g", s.values[k + c]);
+    std::fprintf(f, "\n");
+  }
   std::fprintf(f, "        </DataArray>\n");
 }
 
@@ -83,13 +89,15 @@ void write_vtu(const std::string& path, const Mesh& mesh, const VtuFields& field
   check_size(fields.director.size(), np, "director");
   std::set<std::string> names = {"displacement", "velocity", "director"};
   for (const auto& s : fields.point_scalars) {
-    check_size(s.values.size(), np, "point field '" + s.name + "'");
+    if (s.components < 1) throw std::invalid_argument("write_vtu: field '" + s.name + "' has < 1 component");
+    check_size(s.values.size(), np * static_cast<size_t>(s.components), "point field '" + s.name + "'");
     if (s.name.empty() || !names.insert(s.name).second)
       throw std::invalid_argument("write_vtu: point field name '" + s.name + "' is empty or repeated");
   }
   std::set<std::string> cell_names;
   for (const auto& s : fields.cell_scalars) {
-    check_size(s.values.size(), ne, "cell field '" + s.name + "'");
+    if (s.components < 1) throw std::invalid_argument("write_vtu: field '" + s.name + "' has < 1 component");
+    check_size(s.values.size(), ne * static_cast<size_t>(s.components), "cell field '" + s.name + "'");
     if (s.name.empty() || !cell_names.insert(s.name).second)
       throw std::invalid_argument("write_vtu: cell field name '" + s.name + "' is empty or repeated");
   }

@@ -20,7 +20,8 @@ namespace shelldyn {
 
 struct ScalarField {
   std::string name;
-  std::vector<double> values;  // one per point (point data) or per element (cell data)
+  std::vector<double> values;  // `components` per point (point data) or per element (cell data)
+  int components = 1;          // > 1: a vector/tensor field, values interleaved per point/element
 };
 
 struct VtuFields {

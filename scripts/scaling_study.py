@@ -3,7 +3,7 @@
 per configuration, so peak memory is that configuration's), writes the CSV, fits the exponents and plots.
 
 usage: scaling_study.py [--bin build/bin/bench_scaling] [--csv docs/scaling.csv] [--png docs/img/scaling.png]
-                        [--plot-only] [--quick]
+                        [--plot-only] [--quick] [--series hemisphere|plate]
 
 --plot-only: read the CSV instead of running. --quick: the two smallest meshes only (smoke test).
 Exponents: least-squares slope of log(quantity) against log(unknowns) over the three largest meshes of
@@ -20,10 +20,12 @@ SERIES = {"hemisphere": [4, 8, 12, 16, 24, 32], "plate": [16, 24, 32, 48, 64]}
 THREADS = [1, 2]
 
 
-def run_series(exe, quick):
+def run_series(exe, quick, only):
     rows = []
     header = subprocess.run([exe, "--header"], check=True, capture_output=True, text=True).stdout.strip().split(",")
     for mesh, ns in SERIES.items():
+        if only and mesh != only:
+            continue
         for n in ns[:2] if quick else ns:
             for t in THREADS:
                 env = dict(os.environ, OPENBLAS_NUM_THREADS=str(t), OMP_NUM_THREADS=str(t))
@@ -134,12 +136,13 @@ def main():
     ap.add_argument("--png", default="docs/img/scaling.png")
     ap.add_argument("--plot-only", action="store_true")
     ap.add_argument("--quick", action="store_true")
+    ap.add_argument("--series", choices=sorted(SERIES), help="run one series only")
     a = ap.parse_args()
     if a.plot_only:
         with open(a.csv, newline="") as f:
             rows = list(csv.DictReader(f))
     else:
-        header, rows = run_series(a.bin, a.quick)
+        header, rows = run_series(a.bin, a.quick, a.series)
         with open(a.csv, "w", newline="") as f:
             w = csv.DictWriter(f, fieldnames=header)
             w.writeheader()

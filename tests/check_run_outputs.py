@@ -38,6 +38,8 @@ def main():
         fail("times not increasing")
     # Energy balance of the scheme: H = K + V - W_ext stays ~0 for a body starting at rest (paper §3).
     for r in rows:
+        if not math.isfinite(float(r["rel_drift"])):  # defined while loads act too (docs/manual.md §4)
+            fail("rel_drift = %s at t = %s" % (r["rel_drift"], r["t"]))
         kv = float(r["kinetic"]) + float(r["strain"])
         if not math.isfinite(kv) or abs(float(r["total"])) > energy_tol * max(kv, 1e-300) + 1e-14:
             fail("energy balance violated at t = %s: total %s, K+V %g" % (r["t"], r["total"], kv))
@@ -45,6 +47,12 @@ def main():
     files = [ds.get("file") for ds in root.iter("DataSet")]
     if not files or not all(os.path.exists(os.path.join(d, f)) for f in files):
         fail("fields.pvd lists missing files")
+    # The VTU carries reactions (point data) and stress resultants (cell data) (docs/manual.md §4).
+    names = {a.get("Name") for a in ET.parse(os.path.join(d, files[-1])).getroot().iter("DataArray")}
+    for want in ("reaction", "membrane_force", "bending_moment", "shear_force", "membrane_strain", "curvature",
+                 "shear_strain", "strain_energy_density"):
+        if want not in names:
+            fail("%s lacks the field %s" % (files[-1], want))
     print("ok: %d history rows, %d VTU files, final H = %s" % (len(rows), len(files), rows[-1]["total"]))
 
 

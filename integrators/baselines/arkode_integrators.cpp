@@ -4,7 +4,7 @@
 #include "integrators/sundials/sundials_support.hpp"
 #include "lib/assembler.hpp"
 
-#include <cstdio>  // arkode_butcher.h uses FILE without including it (stack.md §2.2)
+#include <cstdio>  // arkode_butcher.h uses FILE without including it (docs/dependencies.md §2.2)
 #include <arkode/arkode_arkstep.h>
 #include <arkode/arkode_butcher_dirk.h>
 #include <arkode/arkode_butcher_erk.h>
@@ -65,7 +65,7 @@ class ArkodeIntegrator final : public Integrator {
                                   "' (SUNDIALS 6.4.1 names, e.g. " +
                                   (implicit ? "ARKODE_ESDIRK547L2SA_7_4_5, ARKODE_SDIRK_5_3_4"
                                             : "ARKODE_DORMAND_PRINCE_7_4_5, ARKODE_VERNER_8_5_6") +
-                                  "; see spec/stack.md §4.4)");
+                                  "; see docs/dependencies.md §4.4)");
     const bool embedded = B->d != nullptr;
     ARKodeButcherTable_Free(B);
     if (!embedded && !fixed_)
@@ -381,7 +381,7 @@ class ArkodeIntegrator final : public Integrator {
       f[2 * n] = power;
       return 0;
     } catch (const std::domain_error& e) {
-      // Non-finite stage or director overshoot (spec/element.md §2.1 guard): adaptive steppers retry
+      // Non-finite stage or director overshoot (docs/theory.md §2.1 guard): adaptive steppers retry
       // with a smaller step; a fixed step cannot, so stop with the reason.
       if (!self->fixed_) return 1;
       try {
@@ -413,7 +413,7 @@ class ArkodeIntegrator final : public Integrator {
     }
   }
 
-  // Every accepted step: a non-finite state means the step was unstable (stack.md §7 item 11).
+  // Every accepted step: a non-finite state means the step was unstable (docs/dependencies.md §7 item 11).
   static int after_step(sunrealtype t, N_Vector y, void* ud) {
     auto* self = static_cast<ArkodeIntegrator*>(ud);
     if (all_finite(N_VGetArrayPointer(y), 2 * self->n_ + 1)) return 0;

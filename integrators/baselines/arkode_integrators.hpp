@@ -3,7 +3,7 @@
 //
 //     ẏ = f(t, y) = [ v ;  M(q)⁻¹ (F_ext − F_int − F_m) ;  F_ext·v ]
 //
-// ARKStep's mass matrix cannot depend on y in SUNDIALS 6.4.1 (stack.md §4.5), so M(q) is factorized
+// ARKStep's mass matrix cannot depend on y in SUNDIALS 6.4.1 (docs/dependencies.md §4.5), so M(q) is factorized
 // inside every RHS evaluation (mass_solver: eigen-ldlt|cholmod, one symbolic analysis per run);
 // constrained DOFs get v̇_c = 0.
 //
@@ -26,9 +26,9 @@
 //
 // Step control: adaptive (rtol, atol) by default; `fixed_step: true` takes steps of the case's dt
 // (ARKStepSetFixedStep). Explicit fixed-step runs past the stability limit would silently produce NaN
-// (stack.md §7 item 11): a post-step hook checks every step and the run stops with a StepFailure.
+// (docs/dependencies.md §7 item 11): a post-step hook checks every step and the run stops with a StepFailure.
 //
-// Director charts (spec/element.md §2.3): root function g = chart_margin(state(y)) + δ (δ = chart_overshoot, see
+// Director charts (docs/theory.md §2.3): root function g = chart_margin(state(y)) + δ (δ = chart_overshoot, see
 // ida_bdf.hpp), direction −1; at a root the state is written back, system.rechart() converts it, ARKStepReInit restarts from it.
 //
 // Settings: table [ARKODE_DORMAND_PRINCE_7_4_5 (erk) | ARKODE_ESDIRK547L2SA_7_4_5 (dirk)];

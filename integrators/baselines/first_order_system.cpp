@@ -11,7 +11,7 @@ namespace shelldyn {
 
 FirstOrderSystem::FirstOrderSystem(SemiDiscreteSystem& system, const std::string& mass_solver)
     : system_(&system), n_(system.num_dofs()) {
-  // M is SPD: a one-triangle Cholesky/LDLᵀ back-end is both valid and the fastest (stack.md §5.4).
+  // M is SPD: a one-triangle Cholesky/LDLᵀ back-end is both valid and the fastest (docs/dependencies.md §5.4).
   if (mass_solver != "eigen-ldlt" && mass_solver != "cholmod")
     throw std::invalid_argument("mass_solver: '" + mass_solver +
                                 "' is not valid (the mass matrix is SPD: use eigen-ldlt or cholmod)");

@@ -1,5 +1,5 @@
 // The first-order form shared by the SUNDIALS baselines (ida-bdf, arkode-erk, arkode-dirk) of the
-// semi-discrete system M(q) q̈ + F_m(q, q̇) + F_int(q) = F_ext(t, q)   (spec/element.md §5.3):
+// semi-discrete system M(q) q̈ + F_m(q, q̇) + F_int(q) = F_ext(t, q)   (docs/theory.md §5.3):
 //
 //     y = [q; v; w],  n + n + 1 components,   q̇ = v,  M(q) v̇ = F_ext − F_int − F_m,  ẇ = F_ext·v,
 //

@@ -73,7 +73,7 @@ class IdaBdf final : public Integrator {
     M_.values = G_v_.values = K_.values;
     fext_.resize(n_);
 
-    // A director past its chart's margin at the start: switch first (spec/element.md §2.3).
+    // A director past its chart's margin at the start: switch first (docs/theory.md §2.3).
     if (system.chart_margin(state) < 0.0) system.rechart(state);
     fos_->acceleration(state.t, state, state.a);
     w_ = 0.0;
@@ -309,7 +309,7 @@ class IdaBdf final : public Integrator {
       rv[2 * n] = ypv[2 * n] - power;
       return 0;
     } catch (const std::domain_error&) {
-      return 1;  // director overshoot (spec/element.md §2.1 guard) or non-finite: IDA cuts the step
+      return 1;  // director overshoot (docs/theory.md §2.1 guard) or non-finite: IDA cuts the step
     } catch (...) {
       self->errors_.capture("ida-bdf residual");
       return -1;
@@ -354,7 +354,7 @@ class IdaBdf final : public Integrator {
         val[pv] = -self->fext_[j];  // ∂(ẇ − F_ext·v)/∂v_j
       }
       val[bcol[2 * n]] = cj;
-      copy_to_sun_matrix(self->big_, J);  // IDA zeroed J, structure included (stack.md §3.2)
+      copy_to_sun_matrix(self->big_, J);  // IDA zeroed J, structure included (docs/dependencies.md §3.2)
       return 0;
     } catch (const std::domain_error&) {
       return 1;

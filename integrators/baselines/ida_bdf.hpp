@@ -3,7 +3,7 @@
 //
 //     F(t, y, ẏ) = [ q̇ − v ;  M(q) v̇ + F_m(q, v) + F_int(q) − F_ext(t, q) ;  ẇ − F_ext·v ]
 //
-// M(q) is handled exactly (ARKStep cannot: stack.md §4.5). Constrained DOFs c keep q̇_c − v_c = 0 and
+// M(q) is handled exactly (ARKStep cannot: docs/dependencies.md §4.5). Constrained DOFs c keep q̇_c − v_c = 0 and
 // replace their momentum row by v̇_c = 0, so every component is differential (IDASetId all ones).
 //
 // Newton matrix ∂F/∂y + c_j ∂F/∂ẏ on a block CSC pattern built once from pattern() (2n + 1 unknowns):
@@ -26,7 +26,7 @@
 // factorization (exact; no IDACalcIC Newton solve). After a chart switch the Model converts (q, v, v̇)
 // exactly, so IDAReInit gets a consistent (y, ẏ) again.
 //
-// Director charts (spec/element.md §2.3): root function g = chart_margin(state(y)), direction −1
+// Director charts (docs/theory.md §2.3): root function g = chart_margin(state(y)), direction −1
 // (margin going negative), shifted by chart_overshoot δ: g = margin + δ, so the event fires when a director
 // has turned slightly past the diagonal and every node already past it switches in the same event (nodes
 // with nearly equal directors would otherwise trigger one event and one restart each); at a root the state is written back, system.rechart() switches charts and

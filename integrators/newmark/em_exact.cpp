@@ -71,6 +71,10 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
     model_ = dynamic_cast<Model*>(&sys);
     if (!model_)
       throw std::invalid_argument("em-exact: needs the CR9 shell Model (embedded director velocities); got another system");
+    // Its embedded formulation takes nodal dead loads only (docs/manual.md §2.7–2.8): refuse what it would ignore.
+    if (model_->has_damping() || !model_->follower_pressures().empty())
+      throw std::invalid_argument("em-exact: Rayleigh damping and follower pressures are not supported by this "
+                                  "integrator (use em-galpha, or remove 'damping' / the follower_pressure loads)");
     const Index n = sys.num_dofs();
     nn_ = model_->mesh().num_nodes();
     newton_ = std::make_unique<NewtonSolver>(sys.pattern(), nopt_);

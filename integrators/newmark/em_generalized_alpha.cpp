@@ -16,7 +16,7 @@ namespace shelldyn {
 GeneralizedAlphaParameters generalized_alpha_parameters(double rho_inf) {
   if (!(rho_inf >= 0.0 && rho_inf <= 1.0))
     throw std::invalid_argument("rho_inf = " + std::to_string(rho_inf) + " is outside [0, 1]");
-  // spec/element.md §6.1 (Chung–Hulbert; Kuhl–Crisfield GEMM convention x_{n+1−α} = (1−α)x_{n+1} + α x_n).
+  // docs/theory.md §6.1 (Chung–Hulbert; Kuhl–Crisfield GEMM convention x_{n+1−α} = (1−α)x_{n+1} + α x_n).
   GeneralizedAlphaParameters p;
   p.alpha_m = (2.0 * rho_inf - 1.0) / (rho_inf + 1.0);
   p.alpha_f = rho_inf / (rho_inf + 1.0);
@@ -51,7 +51,7 @@ class NewmarkFamily final : public Integrator {
     // Full Newton by default. Modified Newton (reuse of K̄ over iterations and steps) cuts the cost per step
     // by 2-3x on the flying plate at the same iteration count, but it diverges when stiff elements turn
     // fast as rigid bodies (the rotated elastic stiffness leaks into the soft rigid-body directions of a
-    // stale K̄: the spinning plate of benchmarks.md §6 fails at its first step). So a step that fails under
+    // stale K̄: the spinning plate of docs/benchmarks.md §6 fails at its first step). So a step that fails under
     // modified Newton is retried with full Newton before any step cutting.
     const std::string newton = s.get("newton", "full");
     if (newton != "full" && newton != "modified")
@@ -80,7 +80,7 @@ class NewmarkFamily final : public Integrator {
     // (benchmarks/bench_step_breakdown.cpp).
     nopt_.linear_solver = s.get("linear_solver", "cholmod");
     make_linear_solver(nopt_.linear_solver);  // validate the name now, not at the first step
-    // Paper eq. 39 (spec/element.md §6.5): stop when cc = |Δu^(k+1)·P̄^(k)| / |Δu^(1)·P̄^(0)| ≤ cc_tol.
+    // Paper eq. 39 (docs/theory.md §6.5): stop when cc = |Δu^(k+1)·P̄^(k)| / |Δu^(1)·P̄^(0)| ≤ cc_tol.
     // Default 1e-12, far tighter than the paper's 1e-6: conservation studies need the algebraic error well
     // below the time-discretization error (with 1e-8 a tumbling plate drifts by 3e-7 in 2000 steps, with
     // 1e-12 it stays at 4e-9). Because cc ∝ |Δu|², quadratic convergence makes this cost about one extra
@@ -122,6 +122,7 @@ class NewmarkFamily final : public Integrator {
   std::string name() const override { return name_; }
   std::vector<std::pair<std::string, std::string>> settings() const override { return resolved_; }
   double external_work() const override { return work_; }
+  double damping_work() const override { return damping_work_; }
 
   void initialize(SemiDiscreteSystem& sys, State& s) override {
     const Index n = sys.num_dofs();
@@ -130,9 +131,9 @@ class NewmarkFamily final : public Integrator {
     K_ = M_;
     for (Eigen::VectorXd* v : {&un_, &vn_, &an_, &umid_, &vmid_, &amid_, &fint_, &fm_, &fext_, &fint_n_, &fext_n_, &tmp_})
       v->setZero(n);
-    work_ = 0.0;
+    work_ = damping_work_ = 0.0;
     sys.rechart(s, hysteresis_);
-    // Consistent initial acceleration (spec/element.md §6.4 start-up): M(u0) a0 = F_ext − F_int − F_m.
+    // Consistent initial acceleration (docs/theory.md §6.4 start-up): M(u0) a0 = F_ext − F_int − F_m.
     sys.mass(s.u, s.charts, M_);
     sys.internal(s.u, s.charts, fint_.data(), nullptr);
     sys.inertial(s.u, s.v, s.charts, fm_.data());
@@ -183,7 +184,7 @@ class NewmarkFamily final : public Integrator {
     step_with_cuts(sys, s, 0.5 * h, depth + 1, rep);
   }
 
-  // One step of size h from s (spec/element.md §6.6). Returns false (s unchanged but for charts) on failure.
+  // One step of size h from s (docs/theory.md §6.6). Returns false (s unchanged but for charts) on failure.
   bool step(SemiDiscreteSystem& sys, State& s, double h, StepReport& rep, std::string* why, bool full_newton = false) {
     rep.chart_switches += sys.rechart(s, hysteresis_);  // §2.3: between steps only
     // K̄ depends on h (modified Newton). Steps that land on an output time differ from dt in the last bits
@@ -273,6 +274,7 @@ class NewmarkFamily final : public Integrator {
       // §6.4: K̄ = (1−α_m)/(βΔt²) M_mid + (1−α_f) K_mid (symmetric; the (1−α_m) reading of §6.8 item 3).
       profile::Scope prof(profile::Section::combine);
       for (size_t k = 0; k < J.values.size(); ++k) J.values[k] = du * M_.values[k] + (1 - af) * K_.values[k];
+      sys.add_damping_matrix(cu, J);  // ∂(C u̇_mid)/∂u_{n+1} (docs/theory.md §8.5)
       apply_dirichlet(sys.dofs(), J, nullptr);
     };
 
@@ -306,10 +308,14 @@ class NewmarkFamily final : public Integrator {
       *why = r.message + " (cc = " + std::to_string(r.energy_ratio) + ", iterations = " + std::to_string(r.iterations) + ")";
       return false;
     }
-    // Discrete external work with the scheme's own load evaluation (benchmarks.md §0).
+    // Discrete external work with the scheme's own load evaluation (docs/benchmarks.md §0).
     midpoint_state(u.data());
     external_force(u.data());
     work_ += fext_.dot(u - un_);
+    if (sys.has_damping()) {  // dissipated work Δuᵀ C u̇_mid (docs/theory.md §8.5)
+      sys.damping_force(vmid_, tmp_.data());
+      damping_work_ += tmp_.dot(u - un_);
+    }
     // §6.2 Newmark updates.
     s.a = (u - un_) / (be * h * h) - vn_ / (be * h) - (0.5 / be - 1.0) * an_;
     s.v = vn_ + h * ((1 - ga) * an_ + ga * s.a);
@@ -334,7 +340,7 @@ class NewmarkFamily final : public Integrator {
   std::unique_ptr<NewtonSolver> newton_, full_newton_;  // full_newton_: fallback of modified Newton
   SparseMatrix M_, K_;
   Eigen::VectorXd un_, vn_, an_, umid_, vmid_, amid_, fint_, fm_, fext_, fint_n_, fext_n_, tmp_, uscale_;
-  double work_ = 0.0;
+  double work_ = 0.0, damping_work_ = 0.0;
   double energy0_ = 0.0;  // K + V at initialize() (scale of the energy floor)
   double e_floor_ = 0.0;
   double step_tol_ = 1e-14;

@@ -1,4 +1,4 @@
-// The energy–momentum generalized-α scheme of Li & Qian (2025) §3 (spec/element.md §6), and the classical
+// The energy–momentum generalized-α scheme of Li & Qian (2025) §3 (docs/theory.md §6), and the classical
 // schemes that share its Newmark bookkeeping and KINSOL solve, so that comparisons isolate what the strain
 // averaging buys:
 //
@@ -37,7 +37,7 @@ std::unique_ptr<Integrator> make_galpha(IntegratorSettings& settings, double dt)
 std::unique_ptr<Integrator> make_midpoint(IntegratorSettings& settings, double dt);
 std::unique_ptr<Integrator> make_newmark(IntegratorSettings& settings, double dt);
 
-// Chung–Hulbert parameters from the spectral radius at infinity ρ∞ ∈ [0, 1] (spec/element.md §6.1).
+// Chung–Hulbert parameters from the spectral radius at infinity ρ∞ ∈ [0, 1] (docs/theory.md §6.1).
 struct GeneralizedAlphaParameters {
   double alpha_m, alpha_f, beta, gamma;
 };

@@ -128,7 +128,7 @@ struct NewtonSolver::Impl {
         throw std::invalid_argument(
             "the Jacobian callback changed the matrix pattern or the size of its value array; fill "
             "J.values only");
-      // KINSOL zeroed Jm including its structure: refill everything (stack.md §3.2 pitfall 2).
+      // KINSOL zeroed Jm including its structure: refill everything (docs/dependencies.md §3.2 pitfall 2).
       copy_to_sun_matrix(s->Jwork, Jm);
       return 0;
     } catch (...) {
@@ -297,7 +297,7 @@ NewtonSolver::Result NewtonSolver::solve(double* u, const Residual& residual, co
     }
     s.since_setup += static_cast<int>(nni);
 
-    // Energy criterion (element.md §6.5): E = |du · F(u_prev)|.
+    // Energy criterion (docs/theory.md §6.5): E = |du · F(u_prev)|.
     double E = 0;
     for (Index i = 0; i < n; ++i) {
       s.du[i] = uu[i] - s.u_prev[i];

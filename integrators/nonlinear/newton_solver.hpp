@@ -1,12 +1,12 @@
 // Newton solver for F(u) = 0 with a sparse symmetric Jacobian on a fixed pattern: KINSOL (SUNDIALS
 // 6.4.1) does the Newton iterations, the linear systems go through a shelldyn::LinearSolver wrapped
 // as a custom SUNLinearSolver (integrators/sundials/sun_linear_solver.hpp). Used by every implicit scheme of
-// the project, in particular the energy-momentum generalized-α scheme (spec/element.md §6).
+// the project, in particular the energy-momentum generalized-α scheme (docs/theory.md §6).
 //
 // HOW THE ITERATION IS DRIVEN (design decision)
 // ---------------------------------------------
 // KINSOL has no user stopping test, but the integrators need one: a minimum iteration count and the
-// paper's energy criterion (spec/element.md §6.5, paper eq. 39)
+// paper's energy criterion (docs/theory.md §6.5, paper eq. 39)
 //     E_k = |Δu^(k+1) · F(u_k)|,  cc = E_k / E_0,  converged when cc ≤ energy_tol.
 // So solve() runs KINSol with KINSetNumMaxIters(1) in a loop it controls: every KINSol call performs
 // exactly one Newton iteration (Jacobian setup, linear solve, optional line search, update, F at the
@@ -23,7 +23,7 @@
 //     calls, so a factorization is reused over several steps. KINSOL may still refresh by itself
 //     when a line search fails with a stale Jacobian (its own retry logic).
 //   - The symbolic analysis happens once per NewtonSolver lifetime: the pattern is refilled
-//     identically before each setup (KINSOL zeroes the SUNSparseMatrix, stack.md §3.2 pitfall 2)
+//     identically before each setup (KINSOL zeroes the SUNSparseMatrix, docs/dependencies.md §3.2 pitfall 2)
 //     and the custom SUNLinearSolver only re-analyses when the pattern changes.
 //
 // STOPPING TESTS (StopTest) and how they relate
@@ -45,7 +45,7 @@
 // ERRORS. solve() never throws for a failing Newton solve. Result.converged = false with a message
 // when: KINSOL returns a negative flag (its name from KINGetReturnFlagName and the last ‖F‖ are in
 // the message), the residual / Jacobian / hook callback throws (e.g. the director overshoot guard
-// of spec/element.md §2.1; the exception's message is in Result.message), the residual returns a
+// of docs/theory.md §2.1; the exception's message is in Result.message), the residual returns a
 // non-finite value, or the linear solver fails (its message is included). On failure u holds the
 // last iterate KINSOL accepted. Bad arguments (options out of range, null pattern) throw
 // std::invalid_argument from the constructor.

@@ -25,7 +25,7 @@ StaticReport StaticSolver::solve(State& state, double lambda_end, const Observer
   const double eps = 1e-12 * std::max(1.0, std::abs(lambda_end));
 
   while (state.t < lambda_end - eps) {
-    // Charts change only between increments (spec/element.md §2.3).
+    // Charts change only between increments (docs/theory.md §2.3).
     const int switches = model_.rechart(state, options_.rechart_hysteresis);
     report.chart_switches += switches;
     level_switches += switches;

@@ -4,7 +4,7 @@
 // time functions define the load path (a `ramp` with t1 = 1 gives F_ext ∝ λ). Each increment solves
 //     R(u) = F_int(u) − F_ext(λ, u) = 0     (constrained DOFs: identity rows, zero residual)
 // with K(u) − ∂F_ext/∂u (symmetric part) as the Jacobian. Director charts are re-selected between
-// increments (spec/element.md §2.3), never inside a Newton solve. A failed increment (no convergence,
+// increments (docs/theory.md §2.3), never inside a Newton solve. A failed increment (no convergence,
 // or a director overshoot |q| ≥ 1 caught by the element, §2.1 guard) is cut in half and retried from
 // the last converged state; after easy increments the increment grows again, up to the initial size.
 #pragma once

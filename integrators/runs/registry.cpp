@@ -37,7 +37,17 @@ std::vector<std::string> integrator_names() {
 
 std::vector<std::pair<std::string, std::string>> integrator_catalogue() {
   std::vector<std::pair<std::string, std::string>> out;
-  for (const auto& kv : registry()) out.emplace_back(kv.first, kv.second.summary);
+  for (const auto& kv : registry()) {
+    // The settings it reads, with their defaults (docs/manual.md §3), from a probe instance.
+    std::string settings;
+    try {
+      IntegratorSettings probe(kv.first, {});
+      kv.second.factory(probe, 1e-3);
+      for (const auto& [key, value] : probe.resolved()) settings += (settings.empty() ? "" : ", ") + key + "=" + value;
+    } catch (const std::exception&) {
+    }
+    out.emplace_back(kv.first, kv.second.summary + (settings.empty() ? "" : "\n      settings: " + settings));
+  }
   return out;
 }
 

@@ -3,14 +3,17 @@
 
 #include "integrators/sundials/sundials_info.hpp"
 #include "lib/history_writer.hpp"
+#include "lib/reactions.hpp"
 #include "lib/run_info.hpp"
 #include "lib/state_output.hpp"
 
 #include <omp.h>
+#include <unistd.h>
 
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <iostream>
 #include <limits>
 #include <memory>
 
@@ -103,7 +106,9 @@ RunSummary run_dynamic(Problem& problem, const RunOptions& o) {
     write_run_json(o.out_dir + "/run.json", spec, info);
     std::vector<std::string> names;
     for (const auto& m : monitors) names.push_back(m.name);
-    if (spec.output.history) history = std::make_unique<HistoryWriter>(o.out_dir + "/history.csv", std::vector<std::string>{}, names);
+    // damping_work: energy dissipated by Rayleigh damping (docs/theory.md §8.5), only for damped models.
+    const std::vector<std::string> extra = model.has_damping() ? std::vector<std::string>{"damping_work"} : std::vector<std::string>{};
+    if (spec.output.history) history = std::make_unique<HistoryWriter>(o.out_dir + "/history.csv", extra, names);
     if (vtu_every > 0) pvd = std::make_unique<PvdWriter>(o.out_dir + "/fields.pvd");
   }
 
@@ -115,10 +120,17 @@ RunSummary run_dynamic(Problem& problem, const RunOptions& o) {
   Eigen::Vector3d L_ref = Eigen::Vector3d::Zero(), J_ref = Eigen::Vector3d::Zero();
   double last_print = -1.0;
   long long out_index = 0;
+  // Progress (docs/manual.md §1): one line updated in place on a terminal (every 0.2 s of wall time);
+  // otherwise a plain line at every 10 % of the simulated time.
+  const bool tty = o.log && ((o.log == &std::cout && isatty(STDOUT_FILENO)) || (o.log == &std::cerr && isatty(STDERR_FILENO)));
+  bool line_open = false;
+  double next_plain_t = 0.0;
+  double E_seen = 0.0;  // largest K + V or |W_ext| so far: the scale of the energy balance while loads act
 
   auto observe = [&](const StepReport& rep, bool last) {
     const Invariants inv = model.invariants(state);
-    const double H = inv.kinetic + inv.strain - integrator->external_work();
+    const double H = inv.kinetic + inv.strain - integrator->external_work() + integrator->damping_work();
+    E_seen = std::max({E_seen, inv.kinetic + inv.strain, std::abs(integrator->external_work())});
     if (out_index == 0) sum.H0 = H;
     if (!have_ref && state.t >= loads_end - 1e-12 * dt) {
       have_ref = true;
@@ -132,7 +144,9 @@ RunSummary run_dynamic(Problem& problem, const RunOptions& o) {
       sum.ref_L = L_ref.norm();
       sum.ref_J = J_ref.norm();
     }
-    double drift = std::numeric_limits<double>::quiet_NaN();
+    // rel_drift (docs/manual.md §4): while loads act, the error of the discrete energy balance
+    // (H − H0)/max(K + V, |W_ext|) so far; after the loads, (H − H_ref)/(K + V)_ref.
+    double drift = E_seen > 0.0 ? (H - sum.H0) / E_seen : 0.0;
     if (have_ref) {
       const double scale = sum.E_ref > 0.0 ? sum.E_ref : (std::abs(sum.H_ref) > 0.0 ? std::abs(sum.H_ref) : 1.0);
       drift = (H - sum.H_ref) / scale;
@@ -146,7 +160,11 @@ RunSummary run_dynamic(Problem& problem, const RunOptions& o) {
     sum.H_final = H;
     const double wall = std::chrono::duration<double>(Clock::now() - start).count();
     std::vector<double> mon;
-    for (const auto& m : monitors) mon.push_back(monitor_value(m, model.mesh(), state.u, state.v, state.charts));
+    const bool vtu_now = pvd && out_index % vtu_every == 0;
+    Eigen::VectorXd R;  // reaction forces (docs/theory.md §9.2), for monitors rx..rz and the VTU
+    if (vtu_now || monitors_need_reactions(monitors)) R = reactions(model, state, true);
+    for (const auto& m : monitors)
+      mon.push_back(monitor_value(m, model.mesh(), state.u, state.v, state.charts, R.size() ? &R : nullptr));
     if (history) {
       HistoryRow row;
       row.step = sum.totals.steps;
@@ -163,23 +181,31 @@ RunSummary run_dynamic(Problem& problem, const RunOptions& o) {
       row.linear_setups = sum.totals.linear_setups;
       row.wall_s = wall;
       row.monitors = mon;
+      if (model.has_damping()) row.extra = {integrator->damping_work()};
       history->write(row);
     }
-    if (pvd && out_index % vtu_every == 0) {
+    if (vtu_now) {
       const std::string file = "fields/" + vtu_step_file_name(out_index);
-      write_vtu(o.out_dir + "/" + file, model.mesh(), state_fields(model, state));
+      write_vtu(o.out_dir + "/" + file, model.mesh(), state_fields(model, state, &R));
       pvd->add(state.t, file);
     }
-    if (o.log && (last || wall - last_print >= 0.2)) {
+    const bool due = tty ? (last || wall - last_print >= 0.2) : (last || out_index == 0 || state.t >= next_plain_t);
+    if (o.log && due) {
       last_print = wall;
+      while (next_plain_t <= state.t) next_plain_t += 0.1 * t_end > 0.0 ? 0.1 * t_end : 1.0;
       const double eta = state.t > 0.0 ? wall * (t_end - state.t) / state.t : 0.0;
-      char buf[320];
-      std::snprintf(buf, sizeof buf,
-                    "%s%s t = %.6g/%.6g  steps %ld  iters %ld  K %.6g  V %.6g  H %.10g  drift %s  wall %.1f s  ETA %.0f s",
-                    o.label.empty() ? "" : o.label.c_str(), o.label.empty() ? "" : " |", state.t, t_end,
-                    sum.totals.steps, sum.totals.nonlinear_iterations, inv.kinetic, inv.strain, H,
-                    std::isnan(drift) ? "(loads on)" : (std::to_string(drift)).c_str(), wall, eta);
-      *o.log << buf << std::endl;
+      char dr[48];
+      std::snprintf(dr, sizeof dr, have_ref ? "drift %+.2e" : "balance %+.2e (loads on)", drift);
+      char buf[360];
+      std::snprintf(buf, sizeof buf, "%s%st = %.6g/%.6g  steps %ld  iters %ld  K %.4e  V %.4e  H %.6e  %s  wall %.1f s  ETA %.0f s",
+                    o.label.c_str(), o.label.empty() ? "" : " | ", state.t, t_end, sum.totals.steps,
+                    sum.totals.nonlinear_iterations, inv.kinetic, inv.strain, H, dr, wall, eta);
+      if (tty) {
+        *o.log << '\r' << buf << "\x1b[K" << (last ? "\n" : "") << std::flush;
+        line_open = !last;
+      } else {
+        *o.log << buf << std::endl;
+      }
     }
     if (last)
       for (size_t k = 0; k < monitors.size(); ++k) sum.final_monitors.emplace_back(monitors[k].name, mon[k]);
@@ -196,6 +222,7 @@ RunSummary run_dynamic(Problem& problem, const RunOptions& o) {
       observe(rep, k == n_out);
     }
   } catch (const std::exception& e) {
+    if (line_open) *o.log << std::endl;  // end the in-place status line before the error message
     sum.status = std::string("incomplete: ") + e.what();
     sum.wall_seconds = std::chrono::duration<double>(Clock::now() - start).count();
     if (files) {

@@ -2,6 +2,7 @@
 
 #include "integrators/integrator_settings.hpp"
 #include "integrators/sundials/sundials_info.hpp"
+#include "lib/reactions.hpp"
 #include "lib/run_info.hpp"
 #include "lib/state_output.hpp"
 
@@ -35,6 +36,9 @@ std::vector<StaticRow> run_static(Problem& problem, const std::string& out_dir, 
   const CaseSpec& spec = problem.spec;
   const StaticOptions options = static_options(spec);
   Model& model = *problem.model;
+  // Follower loads have a non-symmetric tangent: in full with the LU solver (quadratic Newton), else its
+  // symmetric part (docs/theory.md §8.2).
+  model.set_unsymmetric_load_stiffness(options.newton.linear_solver == "klu");
   const auto& monitors = problem.disc.monitors;
 
   std::unique_ptr<std::ofstream> csv;
@@ -62,7 +66,11 @@ std::vector<StaticRow> run_static(Problem& problem, const std::string& out_dir, 
     row.step = step;
     row.load_factor = s.t;
     row.newton_iterations = iters;
-    for (const auto& m : monitors) row.monitors.push_back(monitor_value(m, model.mesh(), s.u, s.v, s.charts));
+    const bool write_vtu_now = pvd && spec.output.vtu && step % std::max(1, spec.output.vtu_every) == 0;
+    Eigen::VectorXd R;  // reactions (docs/theory.md §9.2), for monitors rx..rz and the VTU
+    if (write_vtu_now || monitors_need_reactions(monitors)) R = reactions(model, s, false);
+    for (const auto& m : monitors)
+      row.monitors.push_back(monitor_value(m, model.mesh(), s.u, s.v, s.charts, R.size() ? &R : nullptr));
     if (csv) {
       char buf[64];
       *csv << step;
@@ -74,9 +82,9 @@ std::vector<StaticRow> run_static(Problem& problem, const std::string& out_dir, 
       }
       *csv << ',' << iters << '\n' << std::flush;
     }
-    if (pvd && spec.output.vtu && step % std::max(1, spec.output.vtu_every) == 0) {
-      const std::string file = vtu_step_file_name(step);
-      write_vtu(out_dir + "/" + file, model.mesh(), state_fields(model, s));
+    if (write_vtu_now) {
+      const std::string file = "fields/" + vtu_step_file_name(step);  // like run (docs/manual.md §4)
+      write_vtu(out_dir + "/" + file, model.mesh(), state_fields(model, s, &R));
       pvd->add(s.t, file);
     }
     rows.push_back(std::move(row));

@@ -1,9 +1,9 @@
 // A custom SUNLinearSolver (type DIRECT, id CUSTOM) wrapping any shelldyn::LinearSolver, so that
 // KINSOL, IDA and ARKODE use CHOLMOD / Eigen LDLᵀ / KLU with one symbolic analysis per run
-// (spec/stack.md §3.4, architecture.md §4.4).
+// (docs/dependencies.md §3.4, architecture.md §4.4).
 //
 // Behaviour of the ops:
-//   initialize: no-op. KINSOL calls it at every KINSol() call (stack.md §3.2 pitfall 1); doing the
+//   initialize: no-op. KINSOL calls it at every KINSol() call (docs/dependencies.md §3.2 pitfall 1); doing the
 //               analysis there would re-analyse once per time step.
 //   setup(A):   A must be a CSC SUNSparseMatrix. (Re)analyses only when A's colptr/rowind differ
 //               from the copy stored at the last analysis (O(nnz) compare, no allocation), then

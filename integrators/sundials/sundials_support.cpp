@@ -8,7 +8,7 @@
 namespace shelldyn {
 
 SunContext::SunContext() {
-  // nullptr communicator = serial (SUNDIALS 6.x signature, stack.md §3.2).
+  // nullptr communicator = serial (SUNDIALS 6.x signature, docs/dependencies.md §3.2).
   const int flag = SUNContext_Create(nullptr, &ctx_);
   if (flag != 0 || ctx_ == nullptr)
     throw std::runtime_error("SUNContext_Create failed with flag " + std::to_string(flag));

@@ -1,5 +1,5 @@
 // Small RAII and error-checking helpers shared by every SUNDIALS adapter (KINSOL, IDA, ARKODE).
-// SUNDIALS 6.4.1, sunindextype = int64_t = shelldyn::Index (spec/stack.md §2.3).
+// SUNDIALS 6.4.1, sunindextype = int64_t = shelldyn::Index (docs/dependencies.md §2.3).
 //
 // Conventions (style.md habit 4): every SUNDIALS return code goes through check_flag() (or a
 // package-specific name lookup) and becomes a std::runtime_error naming the call; constructors that
@@ -77,7 +77,7 @@ SunMatrixPtr make_csc_matrix(const SparsePattern& pattern, SUNContext ctx);
 
 // Writes colptr, rowind AND values of M into the SUNSparseMatrix A. Needed in every Jacobian
 // callback because KINSOL/IDA/ARKODE call SUNMatZero (which also zeroes indexptrs/indexvals) before
-// the user Jacobian (stack.md §3.2 pitfall 2, §7 item 5). Throws std::invalid_argument when A is not
+// the user Jacobian (docs/dependencies.md §3.2 pitfall 2, §7 item 5). Throws std::invalid_argument when A is not
 // CSC, has other dimensions or too little capacity.
 void copy_to_sun_matrix(const SparseMatrix& M, SUNMatrix A);
 

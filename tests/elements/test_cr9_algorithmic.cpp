@@ -1,4 +1,4 @@
-// spec/element.md §6.3 strain-averaged (algorithmic) internal force: consistency with internal() when
+// docs/theory.md §6.3 strain-averaged (algorithmic) internal force: consistency with internal() when
 // u_n = u_np1, and the O(Δu³) energy-balance error of §6.7(a) for alpha_f = 1/2, xi = 0.
 #include <gtest/gtest.h>
 

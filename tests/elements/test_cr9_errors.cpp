@@ -1,4 +1,4 @@
-// Bad input is rejected with exceptions that say what and where (spec §2.1 guard, §2.4 orientation).
+// Bad input is rejected with exceptions that say what and where (docs/theory.md §2.1 guard, §2.4 orientation).
 #include <gtest/gtest.h>
 
 #include <stdexcept>

@@ -1,4 +1,4 @@
-// spec/element.md §7.11 (mass identities, Lagrange-equation check of M q̈ + F_m), §7.2 (kinetic energy,
+// docs/theory.md §7.11 (mass identities, Lagrange-equation check of M q̈ + F_m), §7.2 (kinetic energy,
 // momenta and strain energy are unchanged by a chart switch) and §5.4 momenta.
 #include <gtest/gtest.h>
 

@@ -1,4 +1,4 @@
-// spec/element.md §7.3-7.7: rigid-body invariance, tangent/force consistency, symmetry, null space and
+// docs/theory.md §7.3-7.7: rigid-body invariance, tangent/force consistency, symmetry, null space and
 // local equilibrium of the CR9 internal force, on flat, distorted-flat and cylindrical elements whose
 // normals have dependent component X, Y, Z (and -Z).
 #include <gtest/gtest.h>

@@ -1,4 +1,4 @@
-// spec/element.md §7.1 (A1/A2 vs finite differences) and §7.2 (switching invariance of p, ṗ, p̈),
+// docs/theory.md §7.1 (A1/A2 vs finite differences) and §7.2 (switching invariance of p, ṗ, p̈),
 // plus the §2.1 guard and §2.3 chart selection.
 #include <gtest/gtest.h>
 

@@ -1,4 +1,4 @@
-// spec/element.md §7.8: linear membrane and bending patch tests (K_0 u = 0 with boundary nodes prescribed
+// docs/theory.md §7.8: linear membrane and bending patch tests (K_0 u = 0 with boundary nodes prescribed
 // by the exact field) on a skewed parallelogram mesh and on the MacNeal-Harder 5-element trapezoidal
 // patch; h = 0.001, E = 1e6, nu = 0.25. MITC9 passes exactly on parallelograms; on trapezoids its
 // membrane error is ~1 % (§4.4 known property), and the plain displacement element is exact.
@@ -151,7 +151,7 @@ TEST(PatchTest, MacNealHarderTrapezoids) {
   EXPECT_LT(std::max(bd.d, bd.q), 1e-10);
   EXPECT_LT(std::max(md.d, md.q), 1e-10);
   EXPECT_LT(mm.q, 1e-10);
-  // Measured 0.9445 % (max interior translation error / max |u|), spec §4.4 quotes 0.94 %: MITC9's 2x2
+  // Measured 0.9445 % (max interior translation error / max |u|), docs/theory.md §4.4 quotes 0.94 %: MITC9's 2x2
   // tying of e_xieta on trapezoids. Bound it on both sides so a change of the tying scheme is noticed.
   EXPECT_GT(mm.d, 0.0090);
   EXPECT_LT(mm.d, 0.0100);

@@ -1,6 +1,6 @@
 // Small shell cases with exact or well-understood answers for the SUNDIALS baselines (ida-bdf,
-// arkode-erk, arkode-dirk): the rigid spins of spec/benchmarks.md §6 and the free flight of
-// spec/element.md §7 item 12. Header-only; shared by tests/integrators/test_*.cpp and
+// arkode-erk, arkode-dirk): the rigid spins of docs/benchmarks.md §6 and the free flight of
+// docs/theory.md §7 item 12. Header-only; shared by tests/integrators/test_*.cpp and
 // benchmarks/bench_sundials_baselines.cpp.
 #pragma once
 
@@ -22,14 +22,14 @@ namespace baseline_cases {
 using testing::free_plate;
 
 // Sets the velocity of node i from a translational velocity d and a director rate pdot (converted
-// to the two minor-component rates of the node's chart: q̇ = S ṗ, spec/element.md §2.3).
+// to the two minor-component rates of the node's chart: q̇ = S ṗ, docs/theory.md §2.3).
 inline void set_node_velocity(const Model& model, State& s, int i, const Vec3& d, const Vec3& pdot) {
   s.v.segment<3>(DofMap::dof(i, 0)) = d;
   s.v.segment<2>(DofMap::dof(i, 3)) = chart_coordinates(pdot, s.charts[static_cast<size_t>(i)]);
   (void)model;
 }
 
-// Rigid spin of spec/benchmarks.md §6: plate 2 × 1, h 0.1, ρ 1, E 1e8, ν 0.3, 4 × 2 mesh,
+// Rigid spin of docs/benchmarks.md §6: plate 2 × 1, h 0.1, ρ 1, E 1e8, ν 0.3, 4 × 2 mesh,
 // v = ω × X, ṗ = ω × p. R2: ω = (1, 0, 0), K = 0.00841667, ‖J‖ = 0.0168333.
 // E may be lowered for short tests (the centrifugal strain, ~ρω²a²/E, then grows accordingly).
 inline std::unique_ptr<Model> spin_plate(double E = 1e8) {
@@ -47,7 +47,7 @@ inline State spin_state(const Model& model, const Vec3& omega) {
 constexpr double kR2Kinetic = 0.5 * 0.2 * (1.0 + 0.01) / 12.0;  // ½ I_X ω², I_X = m(b² + h²)/12
 constexpr double kR2AngularMomentum = 0.2 * (1.0 + 0.01) / 12.0;
 
-// Free flight of spec/element.md §7 item 12: two 1 × 1 elements (2 × 1 plate), h 0.1, E 1e6, ν 0.3, ρ 1,
+// Free flight of docs/theory.md §7 item 12: two 1 × 1 elements (2 × 1 plate), h 0.1, E 1e6, ν 0.3, ρ 1,
 // c = centroid (the origin here), ω = (0.3, 0.5, 1), v₀ = (0.1, 0, 0.2), β = 0.5:
 //   ḋ_i = v₀ + ω × (X_i − c) + (0, 0, β((X_i − c)_x² − 0.3)),
 //   ṗ_i = ω × p_i + (−2β (X_i − c)_x, 0, 0) projected onto the plane ⊥ p_i.

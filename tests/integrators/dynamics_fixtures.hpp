@@ -1,6 +1,6 @@
 // Shared set-ups for the time-integration tests: a linear spring–mass system behind the
-// SemiDiscreteSystem interface, and the free-flying plates of spec/element.md §7 item 12 and
-// spec/benchmarks.md §6.
+// SemiDiscreteSystem interface, and the free-flying plates of docs/theory.md §7 item 12 and
+// docs/benchmarks.md §6.
 #pragma once
 
 #include "integrators/newmark/em_generalized_alpha.hpp"
@@ -14,7 +14,7 @@
 namespace shelldyn::testing {
 
 // m ü + k u = 0 with m = 1, k = ω² (one "node" with 5 DOFs, only the first one active; the other four are
-// constrained). The algorithmic force is k[(1−α_f+ξ)u_{n+1} + (α_f−ξ)u_n] (spec/element.md §6.7 SDOF
+// constrained). The algorithmic force is k[(1−α_f+ξ)u_{n+1} + (α_f−ξ)u_n] (docs/theory.md §6.7 SDOF
 // reference) with the symmetric tangent k, as the CR9 element provides.
 class SpringMass final : public SemiDiscreteSystem {
  public:
@@ -85,7 +85,7 @@ inline std::unique_ptr<Model> free_plate(double a, double b, int nx, int ny, con
   return std::make_unique<Model>(std::move(mesh), std::move(normals), mat, std::move(dofs));
 }
 
-// Sets the velocity field of spec/element.md §7 item 12 about the centroid c = 0:
+// Sets the velocity field of docs/theory.md §7 item 12 about the centroid c = 0:
 //   ḋ_i = v0 + ω × X_i + (0, 0, β(X_i,x² − 0.3)),   ṗ_i = ω × p_i + (−2β X_i,x, 0, 0) projected ⊥ p_i.
 inline void set_free_flight_velocity(const Model& model, State& s, const Eigen::Vector3d& v0, const Eigen::Vector3d& w,
                                      double beta) {

@@ -64,7 +64,7 @@ TEST(Arkode, ErkFreeFlightAdaptive) {
   EXPECT_LT(std::abs(total_energy(*model, s, integ->external_work()) - H0) / H0, 1e-8);
 }
 
-// stack.md §7 item 11: past the stability limit a fixed-step ERK silently produces NaN; here it must
+// docs/dependencies.md §7 item 11: past the stability limit a fixed-step ERK silently produces NaN; here it must
 // stop with a StepFailure that says why. dt = 1e-3 is ~50x the measured adaptive ERK step (2e-5).
 TEST(Arkode, FixedStepErkPastItsStabilityLimitThrows) {
   omp_set_num_threads(1);
@@ -93,7 +93,7 @@ TEST(Arkode, FixedStepErkBelowTheLimitRuns) {
   auto integ = ark("arkode-erk", {{"fixed_step", "true"}}, 1e-5);
   integ->initialize(*model, s);
   const StepReport r = integ->advance(*model, s, 1e-3);
-  EXPECT_NEAR(double(r.steps), 100.0, 1.0);  // stop time may add one round-off step (stack.md §4.2)
+  EXPECT_NEAR(double(r.steps), 100.0, 1.0);  // stop time may add one round-off step (docs/dependencies.md §4.2)
   EXPECT_TRUE(s.u.allFinite());
 }
 

@@ -67,7 +67,7 @@ Flight run(Model& model, State s, const std::string& name, double dt, int steps,
   return r;
 }
 
-// spec/element.md §7 item 12 plate (two 1×1 elements, h 0.1, ν 0.3, ρ 1) with its velocity field.
+// docs/theory.md §7 item 12 plate (two 1×1 elements, h 0.1, ν 0.3, ρ 1) with its velocity field.
 Flight fly(const std::string& name, double E, double dt, int steps, Eigen::Vector3d v0, Eigen::Vector3d w, double beta,
            std::vector<std::pair<std::string, std::string>> settings = {}) {
   auto model = free_plate(2.0, 1.0, 2, 1, ShellMaterial{E, 0.3, 1.0, 0.1});
@@ -111,7 +111,7 @@ TEST(EmExact, StiffFreeFlightStaysExact) {
 }
 
 TEST(EmExact, ChartSwitchesAreExact) {
-  // spec/element.md §7.12 switching run (ω = (3, 0.4, 0.2), β = 0.3) at a 5x larger step: 1 s.
+  // docs/theory.md §7.12 switching run (ω = (3, 0.4, 0.2), β = 0.3) at a 5x larger step: 1 s.
   const Flight r = fly("em-exact", 1e6, 0.01, 100, kV0, Eigen::Vector3d(3.0, 0.4, 0.2), 0.3);
   print("switching run, dt 0.01, 1 s", r);
   EXPECT_GE(r.switches, 30);
@@ -122,7 +122,7 @@ TEST(EmExact, ChartSwitchesAreExact) {
   EXPECT_GT(off.max_dH, 1e-8);
 }
 
-// benchmarks.md §6 plate (2 × 1, h 0.1, E 1e8, 4×2 mesh) tumbling about an axis 1 % off the intermediate one.
+// docs/benchmarks.md §6 plate (2 × 1, h 0.1, E 1e8, 4×2 mesh) tumbling about an axis 1 % off the intermediate one.
 TEST(EmExact, TumblingStiffPlateShortRun) {
   auto model = free_plate(2.0, 1.0, 4, 2, ShellMaterial{1e8, 0.3, 1.0, 0.1});
   State s = model->initial_state();

@@ -1,5 +1,5 @@
-// The energy–momentum generalized-α scheme and its classical relatives (spec/element.md §6, §7 items
-// 12–14; spec/benchmarks.md §6): spectral radii on a linear oscillator, conservation in free flight,
+// The energy–momentum generalized-α scheme and its classical relatives (docs/theory.md §6, §7 items
+// 12–14; docs/benchmarks.md §6): spectral radii on a linear oscillator, conservation in free flight,
 // dissipation, director-chart switching, rigid spins, the discrete energy balance under load, and what the
 // strain averaging buys on a stiff free-flying plate.
 #include "integrators/newmark/em_generalized_alpha.hpp"
@@ -54,7 +54,7 @@ std::vector<double> root_moduli(double rho_inf, double xi, double Omega) {
   return m;
 }
 
-// spec/element.md §6.7 table (spectral radius of the principal roots) and §7 item 13.
+// docs/theory.md §6.7 table (spectral radius of the principal roots) and §7 item 13.
 TEST(EmGeneralizedAlpha, SpectralRadiiReproduceTheTable) {
   struct Row {
     double rho, xi;
@@ -92,7 +92,7 @@ struct FlightResult {
   double max_jump_at_switch = 0, max_jump_elsewhere = 0;
 };
 
-// Free flight of spec/element.md §7 item 12 (two 1×1 elements, h 0.1, ν 0.3, ρ 1).
+// Free flight of docs/theory.md §7 item 12 (two 1×1 elements, h 0.1, ν 0.3, ρ 1).
 FlightResult fly(const std::string& name, double E, double dt, int steps, Eigen::Vector3d v0, Eigen::Vector3d w,
                  double beta, std::vector<std::pair<std::string, std::string>> settings = {}) {
   auto model = free_plate(2.0, 1.0, 2, 1, ShellMaterial{E, 0.3, 1.0, 0.1});
@@ -131,12 +131,12 @@ TEST(EmGeneralizedAlpha, FreeFlightConservesMomentumAndBoundsEnergy) {
   std::printf("free flight dt 0.02, 2 s: max|dH|/H %.3e, max|dJ|/|J| %.3e, max|dL|/|L| %.3e, %.2f iterations/step\n",
               r.max_dH, r.max_dJ, r.max_dL, double(r.iterations) / r.steps);
   EXPECT_LT(r.max_dL, 1e-12);  // linear momentum: exact up to round-off and solver tolerance (§6.7)
-  EXPECT_LT(r.max_dH, 2e-4);   // spec §7.12: ≈ 1e-4 (modes not resolved at this dt); measured 9.6e-5
-  EXPECT_LT(r.max_dJ, 1e-5);   // spec §7.12: ≈ 1e-5; measured 8e-8
+  EXPECT_LT(r.max_dH, 2e-4);   // docs/theory.md §7.12: ≈ 1e-4 (modes not resolved at this dt); measured 9.6e-5
+  EXPECT_LT(r.max_dJ, 1e-5);   // docs/theory.md §7.12: ≈ 1e-5; measured 8e-8
 }
 
 TEST(EmGeneralizedAlpha, EnergyErrorFallsWithTheTimeStep) {
-  // spec §7.12: over 0.08 s with v0 = 0, |ΔH|/H ≈ 5e-9 at Δt = 0.002 and 5e-10 at Δt = 0.001.
+  // docs/theory.md §7.12: over 0.08 s with v0 = 0, |ΔH|/H ≈ 5e-9 at Δt = 0.002 and 5e-10 at Δt = 0.001.
   const FlightResult a = fly("em-galpha", 1e6, 0.002, 40, Eigen::Vector3d::Zero(), kW, 0.5);
   const FlightResult b = fly("em-galpha", 1e6, 0.001, 80, Eigen::Vector3d::Zero(), kW, 0.5);
   std::printf("dt 0.002: final %.3e max %.3e; dt 0.001: final %.3e max %.3e\n", a.final_dH, a.max_dH, b.final_dH, b.max_dH);
@@ -154,7 +154,7 @@ TEST(EmGeneralizedAlpha, LinearMomentumIsConservedForEveryParameterChoice) {
 }
 
 TEST(EmGeneralizedAlpha, DissipativeSettingsNeverAddEnergy) {
-  // spec §7.12: ρ∞ = 0.8 or ξ = 0.05 over 100 steps of 0.02: about 4 % energy loss, no growth.
+  // docs/theory.md §7.12: ρ∞ = 0.8 or ξ = 0.05 over 100 steps of 0.02: about 4 % energy loss, no growth.
   for (auto [rho, xi] : {std::pair{0.8, 0.0}, {1.0, 0.05}}) {
     const FlightResult r = fly("em-galpha", 1e6, 0.02, 100, kV0, kW, 0.5,
                                {{"rho_inf", std::to_string(rho)}, {"xi", std::to_string(xi)}});
@@ -166,7 +166,7 @@ TEST(EmGeneralizedAlpha, DissipativeSettingsNeverAddEnergy) {
 }
 
 TEST(EmGeneralizedAlpha, DirectorSwitchingCausesNoEnergyJump) {
-  // spec §7.12: ω = (3, 0.4, 0.2), β = 0.3, Δt = 0.002, 500 steps: 30 switches, |ΔH|/H ≈ 1e-7.
+  // docs/theory.md §7.12: ω = (3, 0.4, 0.2), β = 0.3, Δt = 0.002, 500 steps: 30 switches, |ΔH|/H ≈ 1e-7.
   const FlightResult r = fly("em-galpha", 1e6, 0.002, 500, kV0, Eigen::Vector3d(3.0, 0.4, 0.2), 0.3);
   std::printf("switching run: %ld switches, max|dH|/H %.3e, largest step change at switches %.2e, elsewhere %.2e\n",
               r.switches, r.max_dH, r.max_jump_at_switch, r.max_jump_elsewhere);
@@ -176,7 +176,7 @@ TEST(EmGeneralizedAlpha, DirectorSwitchingCausesNoEnergyJump) {
   EXPECT_LT(r.max_dL, 1e-12);
 }
 
-// spec/benchmarks.md §6: plate 2 × 1, h 0.1, ρ 1, E 1e8, 4×2 mesh, spin about a principal axis.
+// docs/benchmarks.md §6: plate 2 × 1, h 0.1, ρ 1, E 1e8, 4×2 mesh, spin about a principal axis.
 TEST(EmGeneralizedAlpha, RigidSpinsKeepExactEnergyAndAngularMomentum) {
   struct Spin {
     Eigen::Vector3d w;
@@ -209,7 +209,7 @@ TEST(EmGeneralizedAlpha, RigidSpinsKeepExactEnergyAndAngularMomentum) {
     // 3.1e-7 over two (1.25e-6 at Δt = 0.02); R1 keeps p fixed and is exact to round-off.
     EXPECT_LT(max_dK, 5e-7);
     EXPECT_LT(max_dJ, 3e-7);
-    EXPECT_LT(max_V, 1e-6);  // benchmarks.md §6: no spurious strain energy
+    EXPECT_LT(max_V, 1e-6);  // docs/benchmarks.md §6: no spurious strain energy
     // R2 turns every director through 360°: 4 chart switches per node per turn (45 nodes).
     if (spin.w.x() == 1) {
       EXPECT_EQ(switches, 4 * 45);

@@ -1,5 +1,5 @@
 // ida-bdf (integrators/baselines/ida_bdf.hpp): IDA BDF on the residual form of the shell semi-discretization.
-// Short windows only: the free flight of spec/element.md §7 item 12 excites membrane vibrations
+// Short windows only: the free flight of docs/theory.md §7 item 12 excites membrane vibrations
 // (ω up to ~1e5 rad/s) that an adaptive scheme must resolve, so IDA needs ~1e5 steps per second of
 // simulated time at rtol 1e-6 (long runs: benchmarks/bench_sundials_baselines.cpp).
 #include "integrators/baselines/ida_bdf.hpp"

@@ -1,4 +1,4 @@
-// Nonlinear static validation of the CR9 element against Sze, Liu & Lo (2004) (spec/benchmarks.md §4),
+// Nonlinear static validation of the CR9 element against Sze, Liu & Lo (2004) (docs/benchmarks.md §4),
 // run from the case files in apps/cases/ exactly as `shelldyn static` runs them.
 #include "integrators/runs/static_run.hpp"
 
@@ -30,7 +30,7 @@ TEST(StaticBenchmarks, SzeCantileverUnderEndShear) {
               u, w, report.increments, report.newton_iterations);
   EXPECT_NEAR(u, 3.2894, 0.01 * 3.2894);   // issue: horizontal within 1 %
   EXPECT_NEAR(w, 6.6996, 0.005 * 6.6996);  // issue: vertical within 0.5 %
-  EXPECT_GT(report.chart_switches, 0);     // the tip director turns past 45°: charts switch (element.md §7 item 10)
+  EXPECT_GT(report.chart_switches, 0);     // the tip director turns past 45°: charts switch (docs/theory.md §7 item 10)
 }
 
 // Tip position error |x_tip − x_exact| / L at the given moment fractions, for an nx × 1 mesh.
@@ -61,7 +61,7 @@ TEST(StaticBenchmarks, SzeRollUpClosesIntoACircle) {
   std::printf("Sze 3.2: %d increments, %d failed, %d Newton iterations, %d chart switches\n", report.increments,
               report.failed_attempts, report.newton_iterations, report.chart_switches);
   EXPECT_GT(report.chart_switches, 0);  // the director turns through 360°: charts must switch
-  // The error is a discretisation error of order h² (element.md §4.3 linearised director increments):
+  // The error is a discretisation error of order h² (docs/theory.md §4.3 linearised director increments):
   // halving the elements divides it by about 4 (measured 4.1).
   const auto coarse = rollup_errors(16, {1.0}, nullptr);
   EXPECT_GT(coarse[0] / errors.back(), 3.5);
@@ -72,7 +72,7 @@ TEST(StaticBenchmarks, SzePinchedHemisphere) {
   Problem p = load_problem(case_path("sze-hemisphere.yaml"));
   StaticReport report;
   const auto rows = run_static(p, "", nullptr, &report);
-  // Sze's table (benchmarks.md §4.4): load factor -> (outward, inward).
+  // Sze's table (docs/benchmarks.md §4.4): load factor -> (outward, inward).
   const std::map<double, std::pair<double, double>> table = {
       {0.2, {2.321, 3.261}}, {0.4, {3.158, 5.196}}, {0.6, {3.598, 6.497}}, {0.8, {3.875, 7.448}}, {1.0, {4.067, 8.178}},
       {0.3, {2.819, 4.339}}, {0.5, {3.406, 5.902}}, {0.7, {3.750, 7.006}}, {0.9, {3.979, 7.835}}};

@@ -1,6 +1,6 @@
 // The three SUNDIALS baselines side by side (made through the registry, as the apps do): director
-// chart events under adaptive stepping on the rigid spin R2 (spec/benchmarks.md §6), agreement on the
-// free flight of spec/element.md §7 item 12, and energy drift against the tolerance.
+// chart events under adaptive stepping on the rigid spin R2 (docs/benchmarks.md §6), agreement on the
+// free flight of docs/theory.md §7 item 12, and energy drift against the tolerance.
 #include "integrators/integrator.hpp"
 #include "integrators/runs/registry.hpp"
 

@@ -53,7 +53,7 @@ TEST(BenchmarkDiscretization, FlyingPlate) {
   EXPECT_EQ(d.mesh.num_nodes(), 7 * 15 + 6 * 7);  // [0,3]x[0,7] plus [3,6]x[0,3] minus the shared column
   EXPECT_EQ(d.dofs.num_dofs(), 5 * 147);
   EXPECT_EQ(d.dofs.num_constrained(), 0);
-  EXPECT_NEAR(d.total_mass, 3.0, 1e-12);  // benchmarks.md §1.1
+  EXPECT_NEAR(d.total_mass, 3.0, 1e-12);  // docs/benchmarks.md §1.1
   ASSERT_EQ(d.loads.size(), 2u);
   EXPECT_EQ(d.loads[0].node, node_at(d.mesh, Vec3(6, 0, 0)));
   EXPECT_EQ(d.loads[0].vector, Vec3(0, 0, 5));
@@ -79,7 +79,7 @@ TEST(BenchmarkDiscretization, CylindricalPanel) {
   EXPECT_EQ(d.loads[0].node, d.mesh.node_sets.at("corner_x0_arcmin").at(0));
   EXPECT_EQ(d.loads[0].vector, Vec3(0, 1, 1));
   EXPECT_DOUBLE_EQ(d.loads_end, 0.02);
-  // Normals point away from the axis: +Z at the apex line (benchmarks.md §2.3).
+  // Normals point away from the axis: +Z at the apex line (docs/benchmarks.md §2.3).
   const int apex = node_at(d.mesh, Vec3(0, 0, 0));
   ASSERT_GE(apex, 0);
   EXPECT_GT(d.normals[static_cast<size_t>(apex)].z(), 0.999);

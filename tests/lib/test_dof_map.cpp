@@ -1,5 +1,5 @@
 // DOF numbering with constraints, including director constraints that follow chart switches
-// (spec/element.md §2.3 item 2).
+// (docs/theory.md §2.3 item 2).
 #include "lib/dof_map.hpp"
 
 #include <gtest/gtest.h>

@@ -1,6 +1,6 @@
 // Sparse direct solver back-ends (lib/linear_solver.hpp) on a 9-node-shell-like pattern:
 // ne x ne quadratic quads, (2ne+1)^2 nodes, 5 DOF per node, every element couples its 45 DOFs
-// (spec/stack.md §5.1). Values: per element a random SPD block B Bᵀ/45 + 0.01 I, so the assembled
+// (docs/dependencies.md §5.1). Values: per element a random SPD block B Bᵀ/45 + 0.01 I, so the assembled
 // matrix is SPD; an indefinite variant shifts the diagonal.
 #include "lib/linear_solver.hpp"
 

@@ -115,7 +115,7 @@ TEST(MakeRectangle, RejectsBadParameters) {
   expect_invalid([] { make_rectangle(1.0, 1.0, 100000, 100000); }, "nodes");
 }
 
-// FLP-prov plate of spec/benchmarks.md §1.3: [0,3]x[0,7] u [3,6]x[0,3].
+// FLP-prov plate of docs/benchmarks.md §1.3: [0,3]x[0,7] u [3,6]x[0,3].
 TEST(MakeCellUnion, FlyingLShape) {
   const Mesh m = make_cell_union({{0, 0, 3, 7}, {3, 0, 6, 3}}, 1.0);
   expect_valid_mesh(m);
@@ -159,7 +159,7 @@ TEST(MakeCellUnion, RejectsOverlapDisconnectedAndBadInput) {
   expect_invalid([] { make_cell_union({{0, 0, 1, 1}}, 0.0); }, "'cell'");
 }
 
-// spec/benchmarks.md §2.3 geometry.
+// docs/benchmarks.md §2.3 geometry.
 TEST(MakeCylindricalPanel, CountsExactGeometrySetsNormals) {
   const double R = 150, angle = 0.2, L = 30;
   const Mesh m = make_cylindrical_panel(R, angle, L, 6, 4);
@@ -244,7 +244,7 @@ void expect_on_hemisphere(const Mesh& m, double R, double hole_deg) {
   }
 }
 
-// spec/benchmarks.md §§3.2, 4.4 geometry.
+// docs/benchmarks.md §§3.2, 4.4 geometry.
 TEST(MakeHemisphere, QuarterModel) {
   const double R = 10;
   const int n = 4;
@@ -287,7 +287,7 @@ TEST(MakeHemisphere, FullModelWrapsAroundWithoutDuplicates) {
   const auto p = initial_normals(m);
   for (size_t i = 0; i < p.size(); ++i) EXPECT_GT(p[i].dot(m.X[i] / R), std::cos(0.03)) << "node " << i;
   EXPECT_NO_THROW(check_orientation(m, p));
-  // The benchmark mesh (spec/benchmarks.md §3.2): 4 quarters x 8 x 8 = 256 elements.
+  // The benchmark mesh (docs/benchmarks.md §3.2): 4 quarters x 8 x 8 = 256 elements.
   EXPECT_EQ(make_hemisphere(R, 18.0, false, 8).num_elements(), 256);
 }
 

@@ -1,5 +1,5 @@
 // The assembled semi-discretization (lib/model): assembly glue, invariants, re-charting, thread
-// independence, and the linear pinched-hemisphere locking benchmark (spec/element.md §7 item 9).
+// independence, and the linear pinched-hemisphere locking benchmark (docs/theory.md §7 item 9).
 #include "lib/model.hpp"
 
 #include "lib/linear_solver.hpp"
@@ -122,7 +122,7 @@ TEST(Model, ResultsDoNotDependOnTheThreadCount) {
 }
 
 TEST(Model, DeadMomentLoadIsTheWorkConjugateOfTheDirector) {
-  // δW = m·δφ with δp = δφ × p  =>  f_q · δq = (m × p) · A1 δq (spec/element.md §2.3 item 3).
+  // δW = m·δφ with δp = δφ × p  =>  f_q · δq = (m × p) · A1 δq (docs/theory.md §2.3 item 3).
   NodalLoad load;
   load.node = 4;
   load.kind = NodalLoad::Kind::Moment;
@@ -139,7 +139,7 @@ TEST(Model, DeadMomentLoadIsTheWorkConjugateOfTheDirector) {
   EXPECT_EQ(F.head<20>().norm(), 0.0);  // no force on other nodes' DOFs
 }
 
-// spec/element.md §7 item 9: linear pinched hemisphere with an 18° hole, quarter model,
+// docs/theory.md §7 item 9: linear pinched hemisphere with an 18° hole, quarter model,
 // R = 10, h = 0.04, E = 6.825e7, ν = 0.3, unit radial loads; reference ≈ 0.093–0.094.
 double linear_hemisphere(int n) {
   Mesh mesh = make_hemisphere(10.0, 18.0, true, n);

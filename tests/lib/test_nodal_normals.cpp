@@ -1,4 +1,4 @@
-// Initial nodal normals, consistent orientation and the orientation check (spec/element.md §2.4).
+// Initial nodal normals, consistent orientation and the orientation check (docs/theory.md §2.4).
 #include "lib/mesh_generators.hpp"
 #include "lib/nodal_normals.hpp"
 

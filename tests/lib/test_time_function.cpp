@@ -1,4 +1,4 @@
-// Time functions of the case file's loads (lib/time_function.hpp; benchmarks.md §1.2, §3.1).
+// Time functions of the case file's loads (lib/time_function.hpp; docs/benchmarks.md §1.2, §3.1).
 #include "lib/time_function.hpp"
 
 #include <gtest/gtest.h>
@@ -26,7 +26,7 @@ TEST(TimeFunction, RampRisesToOneAndStays) {
 }
 
 TEST(TimeFunction, HatMatchesBenchmarkDefinition) {
-  // benchmarks.md §1.2: t/t1 on [0,t1], 2 - t/t1 on [t1, 2 t1], 0 after.
+  // docs/benchmarks.md §1.2: t/t1 on [0,t1], 2 - t/t1 on [t1, 2 t1], 0 after.
   const double t1 = 2.5;
   const TimeFunction f = TimeFunction::hat(t1);
   EXPECT_EQ(f(-1.0), 0.0);
@@ -39,7 +39,7 @@ TEST(TimeFunction, HatMatchesBenchmarkDefinition) {
 }
 
 TEST(TimeFunction, TriangleMatchesHemisphereLoad) {
-  // benchmarks.md §3.1: P(t) = (20000/3) t before 0.015, 200 - (20000/3) t until 0.03; peak 100.
+  // docs/benchmarks.md §3.1: P(t) = (20000/3) t before 0.015, 200 - (20000/3) t until 0.03; peak 100.
   const TimeFunction f = TimeFunction::triangle(0.015, 0.03);
   for (double t : {0.001, 0.007, 0.0149}) EXPECT_NEAR(100.0 * f(t), 20000.0 / 3.0 * t, 1e-10);
   for (double t : {0.0151, 0.022, 0.0299}) EXPECT_NEAR(100.0 * f(t), 200.0 - 20000.0 / 3.0 * t, 1e-10);
