@@ -309,9 +309,13 @@ NewtonSolver::Result NewtonSolver::solve(double* u, const Residual& residual, co
     double du_norm = 0;
     for (Index i = 0; i < n; ++i) du_norm += (us[i] * s.du[i]) * (us[i] * s.du[i]);
     du_norm = std::sqrt(du_norm);
+    // At round-off (corrections below ~1e3 ε of the scaled iterate) θ is noise, not a verdict on K̄.
+    double u_norm = 0;
+    for (Index i = 0; i < n; ++i) u_norm += (us[i] * uu[i]) * (us[i] * uu[i]);
+    const bool roundoff = du_norm <= 1e3 * std::numeric_limits<double>::epsilon() * std::max(1.0, std::sqrt(u_norm));
     if (!first_call && du_norm_prev > 0) {
       r.contraction = du_norm / du_norm_prev;
-      if (o.modified && o.refresh_contraction > 0 && r.contraction > o.refresh_contraction &&
+      if (o.modified && o.refresh_contraction > 0 && r.contraction > o.refresh_contraction && !roundoff &&
           s.jacobian_evals == jac0)  // this iteration used a stale Jacobian
         s.force_setup = true;
     }

@@ -82,7 +82,8 @@ struct NewtonOptions {
   // times the previous one (θ_k = ‖Δu_k‖/‖Δu_{k−1}‖ > refresh_contraction, measured within one solve()),
   // the next iteration refreshes the Jacobian. With a factorization that is still good θ stays small
   // (e.g. 1e-3 on a mass-dominated K̄) and the factorization is kept over many steps; it grows as the
-  // tangent drifts away, and is observed rather than guessed by a fixed count.
+  // tangent drifts away, and is observed rather than guessed by a fixed count. Corrections at round-off
+  // (‖uscale·Δu‖₂ ≤ 1e3 ε max(1, ‖uscale·u‖₂)) never trigger a refresh: their ratio is noise.
   double refresh_contraction = 0.0;
 };
 
