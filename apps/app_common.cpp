@@ -1,5 +1,6 @@
 #include "apps/app_common.hpp"
 
+#include "integrators/runs/case_integrator.hpp"
 #include "integrators/runs/compare.hpp"
 #include "integrators/runs/registry.hpp"
 #include "integrators/integrator.hpp"
@@ -139,12 +140,75 @@ void check_output_folder(const std::string& dir) {
     throw std::invalid_argument("-o " + dir + ": " + p.string() + " is not writable; choose another output folder");
 }
 
+void prepare_result_folder(const std::string& dir, bool overwrite) {
+  check_output_folder(dir);
+  static const char* outputs[] = {"run.json",    "run.json.tmp", "history.csv",  "fields.pvd", "fields.pvd.tmp",
+                                  "checkpoint.cbor", "checkpoint.cbor.tmp", "static.csv", "summary.csv",
+                                  "summary.md", "energy.png",  "momentum.png", "monitors.png", "work_precision.png"};
+  std::error_code ec;
+  const fs::path d(dir);
+  if (!fs::is_directory(d, ec)) return;
+  std::vector<fs::path> found;
+  for (const char* f : outputs)
+    if (fs::exists(d / f, ec)) found.push_back(d / f);
+  const bool fields = fs::is_directory(d / "fields", ec) && !fs::is_empty(d / "fields", ec);
+  if (found.empty() && !fields) return;
+  if (!overwrite)
+    throw std::invalid_argument("-o " + dir + ": holds results of an earlier run (" +
+                                (found.empty() ? std::string("fields/") : found.front().filename().string()) +
+                                "); add --overwrite to replace them, or choose another folder");
+  for (const auto& p : found) fs::remove(p, ec);
+  if (fs::is_directory(d / "fields", ec))
+    for (const auto& e : fs::directory_iterator(d / "fields", ec))
+      if (e.path().extension() == ".vtu" || e.path().extension() == ".tmp") fs::remove(e.path(), ec);
+}
+
+namespace {
+[[noreturn]] void bad_number(const std::string& flag, double value, const std::string& what, const std::string& example) {
+  std::ostringstream os;
+  os << flag << " must be " << what << " (got " << value << "), e.g. " << example;
+  throw std::invalid_argument(os.str());
+}
+}  // namespace
+
+void check_positive(const std::string& flag, double value, const std::string& example) {
+  if (!std::isfinite(value) || !(value > 0.0) || value > 1e15) bad_number(flag, value, "> 0 and at most 1e15", example);
+}
+
+void check_non_negative(const std::string& flag, double value, const std::string& example) {
+  if (!std::isfinite(value) || !(value >= 0.0) || value > 1e15) bad_number(flag, value, ">= 0 and at most 1e15", example);
+}
+
+void check_range(const std::string& flag, long long value, long long lo, long long hi, const std::string& example) {
+  if (value < lo || value > hi)
+    throw std::invalid_argument(flag + " " + std::to_string(value) + ": must be in " + std::to_string(lo) + ".." +
+                                std::to_string(hi) + ", e.g. " + example);
+}
+
+void print_error(std::ostream& err, const std::string& prefix, const std::string& what) {
+  std::istringstream in(what);
+  std::string line;
+  bool first = true;
+  while (std::getline(in, line)) {
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    if (first) {
+      err << prefix << line << "\n";
+      first = false;
+    } else {
+      const size_t b = line.find_first_not_of(' ');
+      if (b != std::string::npos) err << "  " << line.substr(b) << "\n";
+    }
+  }
+  if (first) err << prefix << "\n";
+}
+
 void check_integrator_name(const std::string& name) {
+  if (name == "static") throw std::invalid_argument("--integrator static: the static solver runs as `shelldyn static CASE`");
   const auto names = integrator_names();
   if (std::find(names.begin(), names.end(), name) != names.end()) return;
   std::string list;
   for (const auto& n : names) list += (list.empty() ? "" : ", ") + n;
-  throw std::invalid_argument("--integrator '" + name + "': unknown integrator (available: " + list + ")");
+  throw std::invalid_argument("--integrator '" + name + "': unknown integrator (see the list below or --help)\navailable: " + list);
 }
 
 std::pair<std::string, std::string> split_setting(const std::string& kv, const std::string& where) {
@@ -208,6 +272,12 @@ BenchmarkApp::BenchmarkApp(std::string name, std::string case_file, std::string 
   cli_.add_option("--threads", o_.threads, "OpenMP threads for element loops (default: all cores)");
   cli_.add_flag("-q,--quiet", o_.quiet, "No progress lines");
   cli_.add_flag("--no-plots", o_.no_plots, "Do not call scripts/plot_run.py");
+  cli_.add_flag("--overwrite", o_.overwrite, "Replace the results of an earlier run in the result folder");
+  cli_.add_option("--checkpoint-every", o_.checkpoint_every,
+                  "Checkpoint every N steps, Ts simulated time (0.5s), Ww wall seconds (60w) or off (default 60w); "
+                  "continue a stopped run with `shelldyn resume DIR`");
+  cli_.add_option("--max-steps", o_.max_steps, "Stop (resumable) at the first output time after N steps (default 0: no limit)");
+  cli_.add_option("--max-wall", o_.max_wall, "Stop (resumable) after S seconds of wall time (default 0: no limit)");
 }
 
 int BenchmarkApp::main(int argc, char** argv) {
@@ -216,27 +286,31 @@ int BenchmarkApp::main(int argc, char** argv) {
     cli_.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     if (e.get_exit_code() == 0) return cli_.exit(e);  // --help
-    std::cerr << name_ << ": error: " << one_line(e.what()) << " (see '" << name_ << " --help')\n";
+    std::cerr << name_ << ": error: " << one_line(e.what()) << " (see '" << name_ << " --help')\n";  // CLI11: one line
     return 2;
   }
   try {
     return run();
+  } catch (const RunStopped& e) {  // signal or limit: everything written, resumable
+    print_error(std::cerr, name_ + ": ", e.what());
+    return e.exit_code();
   } catch (const std::exception& e) {
-    std::cerr << name_ << ": error: " << one_line(e.what()) << "\n";
+    print_error(std::cerr, name_ + ": error: ", e.what());
     return 1;
   }
 }
 
 int BenchmarkApp::run() {
   // --- validate everything before anything is written ---------------------------------------------
-  if (o_.dt < 0.0 || !std::isfinite(o_.dt) || (o_.dt == 0.0 && cli_.count("--dt")))
-    throw std::invalid_argument("--dt must be > 0 (got " + num(o_.dt) + ")");
-  if ((o_.t_end < 0.0 && cli_.count("--t-end")) || !std::isfinite(o_.t_end))
-    throw std::invalid_argument("--t-end must be >= 0 (got " + num(o_.t_end) + ")");
-  if (o_.output_every < 0.0 || !std::isfinite(o_.output_every) || (o_.output_every == 0.0 && cli_.count("--output-every")))
-    throw std::invalid_argument("--output-every must be > 0 (got " + num(o_.output_every) + ")");
-  if (o_.threads < 0) throw std::invalid_argument("--threads must be >= 0 (got " + std::to_string(o_.threads) + ")");
-  if (o_.vtu_every < -1) throw std::invalid_argument("--vtu-every must be >= 0 (got " + std::to_string(o_.vtu_every) + ")");
+  if (cli_.count("--dt")) check_positive("--dt", o_.dt, "--dt 1e-3");
+  if (cli_.count("--t-end")) check_non_negative("--t-end", o_.t_end, "--t-end 6");
+  if (cli_.count("--output-every")) check_positive("--output-every", o_.output_every, "--output-every 0.01");
+  if (cli_.count("--threads")) check_range("--threads", o_.threads, 0, 1024, "--threads 2");
+  if (cli_.count("--vtu-every")) check_range("--vtu-every", o_.vtu_every, 0, 1000000000, "--vtu-every 10 (0: no VTU)");
+  if (cli_.count("--max-steps")) check_range("--max-steps", o_.max_steps, 0, 10000000000LL, "--max-steps 100000");
+  if (cli_.count("--max-wall")) check_non_negative("--max-wall", o_.max_wall, "--max-wall 3600");
+  const CheckpointPolicy policy =
+      o_.checkpoint_every.empty() ? default_checkpoint_policy() : parse_checkpoint_policy(o_.checkpoint_every);
   if (!o_.integrator.empty()) check_integrator_name(o_.integrator);
   std::vector<std::pair<std::string, std::string>> settings;
   for (const auto& kv : o_.settings) settings.push_back(split_setting(kv));
@@ -247,19 +321,14 @@ int BenchmarkApp::run() {
   CaseSpec spec = load_case(case_path);
   if (modify_case) modify_case(spec);
   const std::string integrator = o_.integrator.empty() ? spec.integrator.name : o_.integrator;
-  {  // Check the integrator settings now (run_dynamic would, but only after building the model).
-    IntegratorSettings check = integrator == spec.integrator.name ? IntegratorSettings(spec.integrator)
-                                                                  : IntegratorSettings(integrator, {});
-    for (const auto& [k, v] : settings) check.set(k, v);
-    if (integrator == "static") throw std::invalid_argument("--integrator static: use `shelldyn static CASE`");
-    make_integrator(check, o_.dt > 0.0 ? o_.dt : spec.time.dt);
-  }
+  // Check the integrator settings now, as run_dynamic will (but only after building the model).
+  make_case_integrator(spec, o_.integrator, settings, o_.dt > 0.0 ? o_.dt : spec.time.dt);
   auto overrides = settings;
   if (o_.dt > 0.0) overrides.emplace_back("dt", num(o_.dt));
   const std::string out_dir =
       o_.out_dir.empty() ? (fs::path("results") / (spec.name + folder_suffix) / run_label(integrator, overrides)).string()
                          : o_.out_dir;
-  if (o_.out_dir.empty()) check_output_folder(out_dir);
+  prepare_result_folder(out_dir, o_.overwrite);
   Problem problem = make_problem(std::move(spec));
 
   RunOptions ro;
@@ -274,19 +343,25 @@ int BenchmarkApp::run() {
   ro.log = o_.quiet ? nullptr : &std::cout;
   ro.command = command_;
   ro.label = label;
+  ro.checkpoint = policy;
+  ro.max_steps = o_.max_steps;
+  ro.max_wall = o_.max_wall;
+  ro.handle_signals = true;
+  for (const char* flag : {"--integrator", "--dt", "--t-end", "--output-every", "--vtu-every", "--threads"})
+    if (cli_.count(flag)) ro.overrides.emplace_back(flag, cli_.get_option(flag)->as<std::string>());
+  for (const auto& kv : o_.settings) ro.overrides.emplace_back("--set", kv);
 
   std::cout << name_ << ": " << problem.spec.description << "\n";
   if (!provisional.empty()) std::cout << name_ << ": PROVISIONAL: " << provisional << "\n";
   std::cout << name_ << ": " << integrator << " -> " << out_dir << std::endl;
-  // Stale plots of an earlier run in the same folder must not pass for this run's.
-  for (const char* png : {"energy.png", "momentum.png", "monitors.png"}) {
-    std::error_code ec;
-    fs::remove(fs::path(out_dir) / png, ec);
-  }
   if (before_run) before_run(problem);
   const RunSummary s = run_dynamic(problem, ro);  // throws on failure (run.json: "incomplete: ...")
   print_run_summary(std::cout, s);
   std::cout << "wrote " << out_dir << "/history.csv, " << out_dir << "/fields.pvd, " << out_dir << "/run.json\n";
+  if (!problem.spec.output.history) {  // the report and the plots read history.csv
+    std::cout << name_ << ": no history.csv (output.history is false): no energy report, no plots\n";
+    return 0;
+  }
   {
     const double drift = mechanical_energy_drift(read_csv_table(out_dir + "/history.csv"), problem.model->loads_end());
     std::cout << name_ << ": energy error max |H - H_ref|/(K_ref + V_ref) after the loads end: "

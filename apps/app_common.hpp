@@ -45,6 +45,21 @@ bool run_python_script(const std::string& script, const std::vector<std::string>
 // file, and its nearest existing ancestor must be a writable folder. Creates nothing.
 void check_output_folder(const std::string& dir);
 
+// Result folders are not silently reused: if `dir` already holds outputs of a shelldyn command
+// (run.json, history.csv, fields.pvd, fields/, checkpoint.cbor, static.csv, summary.csv, plots), this
+// throws "use --overwrite" unless `overwrite`, which deletes exactly those outputs (nothing else) so
+// that no stale VTU or row of an earlier run can pass for this one. Also runs check_output_folder().
+void prepare_result_folder(const std::string& dir, bool overwrite);
+
+// Validation of numeric command-line values (every command, every flag): ONE line naming the flag,
+// the value, the allowed range and an example. Non-finite values are always rejected.
+void check_positive(const std::string& flag, double value, const std::string& example);      // 0 < x <= 1e15
+void check_non_negative(const std::string& flag, double value, const std::string& example);  // 0 <= x <= 1e15
+void check_range(const std::string& flag, long long value, long long lo, long long hi, const std::string& example);
+
+// Prints an error the way every command does: the first line of `what` as "PREFIX<line>", each further
+// line (details, e.g. lists of valid names) indented by two spaces.
+void print_error(std::ostream& err, const std::string& prefix, const std::string& what);
 // Where a sweep's runs execute (integrators/runs/executor.hpp), for `shelldyn compare` and other sweep
 // commands: under an MPI launcher (mpirun -n P ..., srun ...) the P ranks (dynamic assignment, rank 0
 // collects; `threads` OpenMP threads per run, 0 → 1, `jobs` ignored); otherwise `jobs` worker threads.
@@ -82,6 +97,10 @@ struct AppOptions {
   int threads = 0;
   bool quiet = false;
   bool no_plots = false;
+  bool overwrite = false;
+  std::string checkpoint_every;  // empty: default_checkpoint_policy()
+  long long max_steps = 0;
+  double max_wall = 0.0;
 };
 
 // What an app run produced, for the app's own report after the run.

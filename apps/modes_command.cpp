@@ -47,7 +47,7 @@ State modes_state(Problem& problem, const std::string& which, bool* loaded) {
     }
     if (!(lambda >= 0.0)) throw std::invalid_argument("--state static:LAMBDA needs LAMBDA >= 0");
     State s = problem.initial_state();
-    StaticSolver solver(*problem.model, static_options(problem.spec));
+    StaticSolver solver(*problem.model, static_options(problem.spec, &problem.disc));
     const StaticReport rep = solver.solve(s, lambda);
     std::cout << "static state: load factor " << s.t << " reached in " << rep.increments << " increments, "
               << rep.newton_iterations << " Newton iterations\n";

@@ -47,6 +47,8 @@ int main(int argc, char** argv) {
       throw std::invalid_argument("--density must be > 0 (got " + std::to_string(density) + "), e.g. --density 1e-3");
   };
   app.modify_case = [&](CaseSpec& spec) {
+    // A case of the user's (--case) keeps its own density unless --density is given.
+    if (app.cli().count("--case") > 0 && app.cli().count("--density") == 0) density = spec.material.rho;
     spec.material.rho = density;
     std::ostringstream os;
     os << density;

@@ -12,13 +12,15 @@
 // can be inspected in ParaView before any time is spent integrating.
 //
 // Exit codes: 0 success; 1 bad input or failure (one line "shelldyn: error: ..." on stderr);
-// 2 command-line usage error.
+// 2 command-line usage error; 3 some runs of `compare` failed; 4 stopped at --max-steps/--max-wall;
+// 130 / 143 stopped by SIGINT / SIGTERM (the last three resumable: `shelldyn resume DIR`).
 //
 // Adding a subcommand (run, static, ...): write `add_<name>_command(CLI::App&, Action&)` next to
 // add_check_command: it registers its options and, in its callback, stores the action to run.
 // main() stays unchanged apart from one call.
 #include "apps/app_common.hpp"
 #include "apps/modes_command.hpp"
+#include "integrators/runs/case_integrator.hpp"
 #include "integrators/runs/compare.hpp"
 #include "integrators/runs/registry.hpp"
 #include "integrators/integrator.hpp"
@@ -71,6 +73,7 @@ struct CheckOptions {
   std::string case_path;
   std::string out_dir;  // empty: results/<case name>
   std::string command;  // the full command line, recorded in run.json
+  bool overwrite = false;
 };
 
 void print_summary(std::ostream& out, const CaseSpec& c, const Discretization& d) {
@@ -155,10 +158,11 @@ VtuFields initial_fields(const Discretization& d) {
 
 int run_check(const CheckOptions& o) {
   const CaseSpec spec = load_case(o.case_path);
+  validate_case_integrator(spec);  // exactly as `run` will (FILE:LINE: integrator.KEY: ...)
   const Discretization d = build_discretization(spec);
-  print_summary(std::cout, spec, d);
-
   const fs::path dir = o.out_dir.empty() ? fs::path("results") / spec.name : fs::path(o.out_dir);
+  app::prepare_result_folder(dir.string(), o.overwrite);
+  print_summary(std::cout, spec, d);
   prepare_output_folder(dir.string());
   const std::string vtu = "fields/" + vtu_step_file_name(0);
   write_vtu((dir / vtu).string(), d.mesh, initial_fields(d));
@@ -194,17 +198,35 @@ void add_check_command(CLI::App& app, Action& action, const std::string& command
       "check", "Validate a case file, print a summary and write the initial state (VTU, PVD, run.json)");
   sub->add_option("case", opts->case_path, "Case file (YAML), e.g. apps/cases/flying-plate.yaml")->required();
   sub->add_option("-o,--output", opts->out_dir, "Result folder (default: results/<case name>)");
+  sub->add_flag("--overwrite", opts->overwrite, "Replace the results of an earlier command in the result folder");
   sub->callback([opts, &action] { action = [opts] { return run_check(*opts); }; });
 }
 
 // --- run ---------------------------------------------------------------------------------------------
 struct RunCommandOptions {
-  std::string case_path, out_dir, integrator, command;
+  std::string case_path, out_dir, integrator, command, checkpoint_every;
   std::vector<std::string> settings;  // key=value
-  double dt = 0.0, t_end = -1.0, output_every = 0.0;
+  double dt = 0.0, t_end = -1.0, output_every = 0.0, max_wall = 0.0;
   int vtu_every = -1, threads = 0;
-  bool quiet = false, plots = false;
+  long long max_steps = 0;
+  bool quiet = false, overwrite = false, plots = false;
+  CLI::App* cli = nullptr;  // to ask which flags were given
+  bool given(const char* flag) const {
+    const CLI::Option* opt = cli ? cli->get_option_no_throw(flag) : nullptr;
+    return opt && opt->count() > 0;
+  }
 };
+
+// Numeric flags of `run` and `resume`: validated before anything is read or written.
+void check_run_flags(const RunCommandOptions& o) {
+  if (o.given("--dt")) app::check_positive("--dt", o.dt, "--dt 1e-3");
+  if (o.given("--t-end")) app::check_non_negative("--t-end", o.t_end, "--t-end 6");
+  if (o.given("--output-every")) app::check_positive("--output-every", o.output_every, "--output-every 0.01");
+  if (o.given("--vtu-every")) app::check_range("--vtu-every", o.vtu_every, 0, 1000000000, "--vtu-every 10 (0: no VTU)");
+  if (o.given("--threads")) app::check_range("--threads", o.threads, 0, 1024, "--threads 2");
+  if (o.given("--max-steps")) app::check_range("--max-steps", o.max_steps, 0, 10000000000LL, "--max-steps 100000");
+  if (o.given("--max-wall")) app::check_non_negative("--max-wall", o.max_wall, "--max-wall 3600");
+}
 
 std::pair<std::string, std::string> split_setting(const std::string& kv) {
   const auto eq = kv.find('=');
@@ -214,12 +236,26 @@ std::pair<std::string, std::string> split_setting(const std::string& kv) {
 }
 
 int run_run(const RunCommandOptions& o) {
-  Problem problem = load_problem(o.case_path);
+  check_run_flags(o);
+  const CheckpointPolicy policy =
+      o.checkpoint_every.empty() ? default_checkpoint_policy() : parse_checkpoint_policy(o.checkpoint_every);
+  if (!o.integrator.empty()) app::check_integrator_name(o.integrator);
   RunOptions ro;
   ro.integrator = o.integrator;
   for (const auto& kv : o.settings) ro.settings.push_back(split_setting(kv));
-  if (o.dt < 0.0) throw std::invalid_argument("--dt must be > 0 (got " + std::to_string(o.dt) + ")");
-  if (o.t_end < 0.0 && o.t_end != -1.0) throw std::invalid_argument("--t-end must be >= 0 (got " + std::to_string(o.t_end) + ")");
+  CaseSpec spec = load_case(o.case_path);
+  make_case_integrator(spec, o.integrator, ro.settings, o.dt > 0.0 ? o.dt : spec.time.dt);  // before any output
+  const std::string integrator_name = o.integrator.empty() ? spec.integrator.name : o.integrator;
+  ro.out_dir = o.out_dir.empty() ? (fs::path("results") / spec.name / integrator_name).string() : o.out_dir;
+  app::prepare_result_folder(ro.out_dir, o.overwrite);
+  Problem problem = make_problem(std::move(spec));
+  ro.checkpoint = policy;
+  ro.max_steps = o.max_steps;
+  ro.max_wall = o.max_wall;
+  ro.handle_signals = true;
+  for (const char* flag : {"--integrator", "--dt", "--t-end", "--output-every", "--vtu-every", "--threads", "--max-steps", "--max-wall", "--checkpoint-every"})
+    if (o.given(flag)) ro.overrides.emplace_back(flag, o.cli->get_option(flag)->as<std::string>());
+  for (const auto& kv : o.settings) ro.overrides.emplace_back("--set", kv);
   ro.dt = o.dt;
   ro.t_end = o.t_end;
   ro.output_interval = o.output_every;
@@ -227,12 +263,10 @@ int run_run(const RunCommandOptions& o) {
   ro.threads = o.threads;
   ro.command = o.command;
   ro.log = o.quiet ? nullptr : &std::cout;
-  const std::string integrator = o.integrator.empty() ? problem.spec.integrator.name : o.integrator;
-  ro.out_dir = o.out_dir.empty() ? (fs::path("results") / problem.spec.name / integrator).string() : o.out_dir;
-  std::cout << "shelldyn run: " << problem.spec.name << " with " << integrator << " -> " << ro.out_dir << std::endl;
+  std::cout << "shelldyn run: " << problem.spec.name << " with " << integrator_name << " -> " << ro.out_dir << std::endl;
   const RunSummary s = run_dynamic(problem, ro);
   if (o.quiet) {  // one line: status, steps, energy error after the loads
-    std::printf("%s: %s, %ld steps, max |H - H_ref|/(K+V)_ref after loads %.3g -> %s\n", integrator.c_str(),
+    std::printf("%s: %s, %ld steps, max |H - H_ref|/(K+V)_ref after loads %.3g -> %s\n", integrator_name.c_str(),
                 s.status.c_str(), s.totals.steps, s.max_rel_drift, ro.out_dir.c_str());
   } else {
     print_run_summary(std::cout, s);
@@ -243,7 +277,7 @@ int run_run(const RunCommandOptions& o) {
       std::error_code ec;
       fs::remove(fs::path(ro.out_dir) / png, ec);
     }
-    if (!app::run_python_script(app::find_script("plot_run.py"), {ro.out_dir, "--title", problem.spec.name + ", " + integrator},
+    if (!app::run_python_script(app::find_script("plot_run.py"), {ro.out_dir, "--title", problem.spec.name + ", " + integrator_name},
                                 std::cout))
       return 1;
     if (!o.quiet) std::cout << "wrote " << ro.out_dir << "/energy.png, momentum.png, monitors.png\n";
@@ -265,16 +299,63 @@ void add_run_command(CLI::App& app, Action& action, const std::string& command) 
   sub->add_option("--t-end", o->t_end, "End time (default: the case's time.t_end)");
   sub->add_option("--output-every", o->output_every, "Output interval in time units (default: the case's time.output_interval)");
   sub->add_option("--vtu-every", o->vtu_every, "Write a VTU every N output times; 0 disables (default: the case's output.vtu_every)");
-  sub->add_option("--threads", o->threads, "OpenMP threads for element loops (default: all cores)")->check(CLI::NonNegativeNumber);
+  sub->add_option("--threads", o->threads, "OpenMP threads for element loops (default: all cores)");
   sub->add_flag("-q,--quiet", o->quiet, "No progress line and no summary table: one result line (errors still reported)");
   sub->add_flag("--plots", o->plots, "After the run, write energy.png, momentum.png, monitors.png with scripts/plot_run.py (needs python3-matplotlib)");
+  sub->add_option("--checkpoint-every", o->checkpoint_every,
+                  "Write DIR/checkpoint.cbor every N steps, Ts of simulated time (e.g. 0.5s) or Ww seconds of wall "
+                  "time (e.g. 60w); off disables (default 60w)");
+  sub->add_option("--max-steps", o->max_steps, "Stop (resumable, exit 4) at the first output time after N steps (default 0: no limit)");
+  sub->add_option("--max-wall", o->max_wall, "Stop (resumable, exit 4) after S seconds of wall time (default 0: no limit)");
+  sub->add_flag("--overwrite", o->overwrite, "Replace the results of an earlier run in the result folder");
+  o->cli = sub;
   sub->callback([o, &action] { action = [o] { return run_run(*o); }; });
+}
+
+// --- resume ------------------------------------------------------------------------------------------
+// `shelldyn resume DIR`: continues a run stopped by a signal, --max-wall/--max-steps or a kill from
+// DIR/checkpoint.cbor (integrators/runs/run_driver.hpp). The case, options and overrides come from the
+// checkpoint; only the limits, the thread count and the progress output can be changed.
+int run_resume(const RunCommandOptions& o) {
+  check_run_flags(o);
+  const std::string dir = o.case_path;
+  const Checkpoint c = read_checkpoint((fs::path(dir) / checkpoint_file_name()).string());
+  Problem problem = problem_from_checkpoint(c);
+  RunOptions ro = run_options_from_checkpoint(c);
+  ro.out_dir = dir;
+  ro.resume = &c;
+  ro.handle_signals = true;
+  ro.log = o.quiet ? nullptr : &std::cout;
+  if (o.given("--max-steps")) ro.max_steps = o.max_steps;
+  if (o.given("--max-wall")) ro.max_wall = o.max_wall;
+  if (o.given("--threads")) ro.threads = o.threads;
+  std::cout << "shelldyn resume: " << problem.spec.name << " with " << c.integrator << " from t = " << c.state.t
+            << (c.integrator_data.exact ? " (bitwise continuation)" : " (re-initialized from the saved state)") << " -> "
+            << dir << std::endl;
+  const RunSummary s = run_dynamic(problem, ro);
+  print_run_summary(std::cout, s);
+  std::cout << "wrote " << dir << "/history.csv, " << dir << "/run.json\n";
+  return 0;
+}
+
+void add_resume_command(CLI::App& app, Action& action, const std::string& command) {
+  auto o = std::make_shared<RunCommandOptions>();
+  o->command = command;
+  CLI::App* sub = app.add_subcommand("resume", "Continue a stopped or killed run from its checkpoint (DIR/checkpoint.cbor)");
+  sub->add_option("dir", o->case_path, "Result folder of the run, e.g. results/flying-plate/em-galpha")->required();
+  sub->add_option("--max-steps", o->max_steps, "Stop again at the first output time after N steps in total (default: as before)");
+  sub->add_option("--max-wall", o->max_wall, "Stop again after S seconds of wall time in total (default: as before)");
+  sub->add_option("--threads", o->threads, "OpenMP threads for element loops (default: all cores)");
+  sub->add_flag("-q,--quiet", o->quiet, "No progress lines");
+  o->cli = sub;
+  sub->callback([o, &action] { action = [o] { return run_resume(*o); }; });
 }
 
 // --- static ------------------------------------------------------------------------------------------
 int run_static_command(const CheckOptions& o) {
   Problem problem = load_problem(o.case_path);
   const std::string dir = o.out_dir.empty() ? (fs::path("results") / problem.spec.name / "static").string() : o.out_dir;
+  app::prepare_result_folder(dir, o.overwrite);
   std::cout << "shelldyn static: " << problem.spec.name << " -> " << dir << std::endl;
   StaticReport report;
   const auto rows = run_static(problem, dir, &std::cout, &report);
@@ -290,13 +371,15 @@ void add_static_command(CLI::App& app, Action& action, const std::string& comman
   opts->command = command;
   CLI::App* sub = app.add_subcommand(
       "static",
-      "Solve a static case by load stepping (integrator: static); write static.csv, VTU/PVD, run.json.\n"
-      "Case settings (integrator: {name: static, ...}; docs/manual.md §3): increment=time.dt (load-factor step), "
-      "min_increment=increment*1e-4, growth=1.5, easy_iterations=6, hysteresis=1, max_iters=30, tol=1e-9 "
-      "(max-norm residual relative to the applied load), linear_solver=eigen-ldlt (klu: full non-symmetric "
-      "follower-load tangent), line_search=false. The load factor runs from 0 to time.t_end.");
+      "Solve a static case (integrator: static); write static.csv, VTU/PVD, run.json.\n"
+      "Case settings (integrator: {name: static, ...}; docs/statics.md): control=load|arc_length|displacement, "
+      "increment=time.dt, min_increment, growth=1.5, easy_iterations=6, target_iterations=5, max_arc_factor=4, "
+      "max_steps=1000, max_iters=30, tol=1e-8 (residual relative to max(|F_ext|, |F_int| incl. reactions)), "
+      "step_tol=1e-10 (correction relative to the displacement scale), jump_ratio=5, linear_solver=eigen-ldlt (klu: "
+      "full non-symmetric follower-load tangent, no inertia), control_set/control_dof/displacement_end, hysteresis=1.");
   sub->add_option("case", opts->case_path, "Case file (YAML), e.g. apps/cases/sze-hemisphere.yaml")->required();
   sub->add_option("-o,--output", opts->out_dir, "Result folder (default: results/<case>/static)");
+  sub->add_flag("--overwrite", opts->overwrite, "Replace the results of an earlier command in the result folder");
   sub->callback([opts, &action] { action = [opts] { return run_static_command(*opts); }; });
 }
 
@@ -313,6 +396,7 @@ struct CompareCommandOptions {
   double t_end = -1.0, output_every = 0.0;
   int jobs = 2, threads = 0, vtu_every = 0;
   bool no_plots = false, resume = false;
+  CLI::App* cli = nullptr;
 };
 
 int run_compare(const CompareCommandOptions& o) {
@@ -320,8 +404,13 @@ int run_compare(const CompareCommandOptions& o) {
   co.case_path = o.case_path;
   if (!fs::exists(co.case_path) && co.case_path.find('/') == std::string::npos)
     co.case_path = app::find_case_file(co.case_path + (fs::path(co.case_path).extension() == ".yaml" ? "" : ".yaml"));
-  if (o.t_end < 0.0 && o.t_end != -1.0) throw std::invalid_argument("--t-end must be >= 0 (got " + std::to_string(o.t_end) + ")");
-  if (o.jobs < 1) throw std::invalid_argument("--jobs must be >= 1 (got " + std::to_string(o.jobs) + ")");
+  if (o.cli->count("--t-end")) app::check_non_negative("--t-end", o.t_end, "--t-end 6");
+  if (o.cli->count("--output-every")) app::check_positive("--output-every", o.output_every, "--output-every 0.01");
+  for (double dt : o.dts) app::check_positive("--dt", dt, "--dt 1e-3,2e-3");
+  for (double r : o.rtols) app::check_positive("--rtol", r, "--rtol 1e-6,1e-8");
+  app::check_range("--jobs", o.jobs, 1, 64, "--jobs 2");
+  app::check_range("--threads", o.threads, 0, 1024, "--threads 2");
+  app::check_range("--vtu-every", o.vtu_every, 0, 1000000000, "--vtu-every 10");
   co.specs = o.specs;
   co.dts = o.dts;
   co.rtols = o.rtols;
@@ -377,14 +466,15 @@ void add_compare_command(CLI::App& app, Action& action, const std::string& comma
       ->delimiter(',');
   sub->add_option("--t-end", o->t_end, "End time (default: the case's time.t_end)");
   sub->add_option("--output-every", o->output_every, "Output interval (default: the case's)");
-  sub->add_option("--vtu-every", o->vtu_every, "VTU every N output times per run (default 0: none)")->check(CLI::NonNegativeNumber);
+  sub->add_option("--vtu-every", o->vtu_every, "VTU every N output times per run (default 0: none)");
   sub->add_option("-o,--output", o->out_dir, "Result folder (default: results/<case>/compare)");
   sub->add_option("--jobs", o->jobs, "Runs at a time, each single-threaded when > 1 (default 2); under mpirun/srun: one run "
                                      "per rank at a time, --jobs is ignored");
   sub->add_option("--threads", o->threads, "OpenMP threads per run when --jobs 1 (default: all cores); under mpirun/srun: per "
-                                           "rank (default 1)")->check(CLI::NonNegativeNumber);
+                                           "rank (default 1)");
   sub->add_flag("--resume", o->resume, "Do not rerun runs that an earlier sweep into the same folder finished with the same "
                                        "settings (their compare-outcome.txt); run only the missing or failed ones");
+  o->cli = sub;
   sub->add_option("--reference", o->reference, "Label of the reference run for displacement errors (default: finest fixed-step run)");
   sub->add_flag("--no-plots", o->no_plots, "Do not call scripts/plot_compare.py");
   sub->callback([o, &action] { action = [o] { return run_compare(*o); }; });
@@ -406,6 +496,7 @@ int main(int argc, char** argv) {
   add_static_command(app, action, command);
   app::add_modes_command(app, action, command);
   add_compare_command(app, action, command);
+  add_resume_command(app, action, command);
 
   try {
     app.parse(argc, argv);
@@ -416,8 +507,11 @@ int main(int argc, char** argv) {
   }
   try {
     return action();
+  } catch (const RunStopped& e) {  // signal or limit: everything written, resumable (exit 130/143/4)
+    app::print_error(std::cerr, "shelldyn: ", e.what());
+    return e.exit_code();
   } catch (const std::exception& e) {
-    std::cerr << "shelldyn: error: " << one_line(e.what()) << "\n";
+    app::print_error(std::cerr, "shelldyn: error: ", e.what());
     return 1;
   }
 }

@@ -18,4 +18,24 @@ void StepReport::accumulate(const StepReport& r) {
   wall_seconds += r.wall_seconds;
 }
 
+double IntegratorCheckpoint::scalar(const std::string& key) const {
+  const auto it = scalars.find(key);
+  if (it == scalars.end()) throw std::runtime_error("checkpoint: integrator scalar '" + key + "' is missing");
+  return it->second;
+}
+
+const Eigen::VectorXd& IntegratorCheckpoint::vector(const std::string& key) const {
+  const auto it = vectors.find(key);
+  if (it == vectors.end()) throw std::runtime_error("checkpoint: integrator vector '" + key + "' is missing");
+  return it->second;
+}
+
+void Integrator::save(IntegratorCheckpoint&) const {
+  throw std::runtime_error("integrator " + name() + " does not support checkpoints (use --checkpoint-every 0)");
+}
+
+void Integrator::restore(SemiDiscreteSystem&, State&, const IntegratorCheckpoint&) {
+  throw std::runtime_error("integrator " + name() + " does not support checkpoints: rerun from the start");
+}
+
 }  // namespace shelldyn

@@ -17,6 +17,10 @@
 #include "lib/semi_discrete_system.hpp"
 #include "lib/state.hpp"
 
+#include <Eigen/Core>
+
+#include <functional>
+#include <map>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -48,6 +52,27 @@ class StepFailure : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+// Thrown by advance() when a stop request (see Integrator::set_stop_request) made it abandon the
+// current output interval; the state passed to advance() is then unchanged (the last output state).
+class RunInterrupted : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+// What an integrator carries between advance() calls beyond the State (checkpoint/restart,
+// docs/architecture.md "Checkpoints and resume"): named vectors and scalars, stored exactly.
+struct IntegratorCheckpoint {
+  std::map<std::string, Eigen::VectorXd> vectors;
+  std::map<std::string, double> scalars;
+  // true: a run restored from it continues bitwise as the uninterrupted run would; false: the
+  // integrator restarts from the saved state (e.g. SUNDIALS re-initialization: step-size and order
+  // history are lost, results agree to the tolerances only).
+  bool exact = false;
+
+  double scalar(const std::string& key) const;                 // throws naming the key if absent
+  const Eigen::VectorXd& vector(const std::string& key) const;  // likewise
+};
+
 class Integrator {
  public:
   virtual ~Integrator() = default;
@@ -63,6 +88,24 @@ class Integrator {
   // Work dissipated by Rayleigh damping so far, Σ Δqᵀ C q̇ with the scheme's own velocity (docs/theory.md
   // §8.5); H = K + V − W_ext + W_damp is then the conserved total. 0 for integrators that do not track it.
   virtual double damping_work() const { return 0.0; }
+
+  // Checkpoint/restart. save() is called between advance() calls (or after an advance() that stopped
+  // early on a stop request), restore() right after initialize() with the saved State already in
+  // `state`. The defaults throw, so a new integrator compiles unchanged and says what is missing.
+  virtual void save(IntegratorCheckpoint& out) const;
+  virtual void restore(SemiDiscreteSystem& system, State& state, const IntegratorCheckpoint& in);
+
+  // Cooperative stop (SIGINT/SIGTERM, --max-wall; integrators/runs/run_driver.hpp). Integrators poll
+  // stop_requested() between steps (fixed-step schemes: advance() then returns early with
+  // state.t < t_out at a step boundary) or inside their solver callbacks (SUNDIALS: advance() throws
+  // RunInterrupted with the state unchanged). Integrators that never poll finish the output interval.
+  void set_stop_request(std::function<bool()> requested) { stop_request_ = std::move(requested); }
+
+ protected:
+  bool stop_requested() const { return stop_request_ && stop_request_(); }
+
+ private:
+  std::function<bool()> stop_request_;
 };
 
 }  // namespace shelldyn

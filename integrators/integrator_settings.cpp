@@ -87,7 +87,7 @@ void IntegratorSettings::finish() const {
     std::string valid;
     for (const auto& k : asked_) valid += (valid.empty() ? "" : ", ") + k;
     throw std::invalid_argument(where_ + "." + kv.first + ": unknown setting for integrator '" + name_ +
-                                "' (valid: " + valid + ")");
+                                "' (check the spelling; valid ones below)\nvalid: " + valid);
   }
 }
 

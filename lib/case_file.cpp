@@ -182,7 +182,8 @@ MeshSpec parse_mesh(const Parser& p, const YAML::Node& n, const std::string& bas
     return MeshFileSpec{fs::absolute(path).lexically_normal().string()};
   }
   const YAML::Node gen = n["generator"];
-  const size_t kind = p.choice(gen, "mesh.generator", {"rectangle", "cell_union", "cylindrical_panel", "hemisphere"});
+  const size_t kind = p.choice(gen, "mesh.generator", {"rectangle", "cell_union", "cylindrical_panel", "hemisphere",
+                                                       "cylinder_patch", "closed_cylinder", "slit_annulus"});
   switch (kind) {
     case 0: {
       p.check_keys(n, "mesh", {"generator", "a", "b", "nx", "ny", "x0", "y0"}, {"a", "b", "nx", "ny"});
@@ -224,6 +225,37 @@ MeshSpec parse_mesh(const Parser& p, const YAML::Node& n, const std::string& bas
       s.length = p.positive(n["length"], "mesh.length");
       s.n_arc = p.count(n["n_arc"], "mesh.n_arc");
       s.n_axial = p.count(n["n_axial"], "mesh.n_axial");
+      return s;
+    }
+    case 4: {
+      p.check_keys(n, "mesh", {"generator", "radius", "angle", "length", "n_arc", "n_axial"},
+                   {"radius", "angle", "length", "n_arc", "n_axial"});
+      CylinderPatchMeshSpec s;
+      s.radius = p.positive(n["radius"], "mesh.radius");
+      s.angle = p.positive(n["angle"], "mesh.angle");
+      if (s.angle > 3.141592653589793) p.fail(n["angle"], "mesh.angle", "must be <= pi (opening angle in radians from the plane Y = 0)");
+      s.length = p.positive(n["length"], "mesh.length");
+      s.n_arc = p.count(n["n_arc"], "mesh.n_arc");
+      s.n_axial = p.count(n["n_axial"], "mesh.n_axial");
+      return s;
+    }
+    case 5: {
+      p.check_keys(n, "mesh", {"generator", "radius", "length", "n_circ", "n_axial"}, {"radius", "length", "n_circ", "n_axial"});
+      ClosedCylinderMeshSpec s;
+      s.radius = p.positive(n["radius"], "mesh.radius");
+      s.length = p.positive(n["length"], "mesh.length");
+      s.n_circ = p.count(n["n_circ"], "mesh.n_circ");
+      s.n_axial = p.count(n["n_axial"], "mesh.n_axial");
+      return s;
+    }
+    case 6: {
+      p.check_keys(n, "mesh", {"generator", "r_inner", "r_outer", "n_radial", "n_circ"}, {"r_inner", "r_outer", "n_radial", "n_circ"});
+      SlitAnnulusMeshSpec s;
+      s.r_inner = p.positive(n["r_inner"], "mesh.r_inner");
+      s.r_outer = p.positive(n["r_outer"], "mesh.r_outer");
+      if (!(s.r_outer > s.r_inner)) p.fail(n["r_outer"], "mesh.r_outer", "must be > r_inner");
+      s.n_radial = p.count(n["n_radial"], "mesh.n_radial");
+      s.n_circ = p.count(n["n_circ"], "mesh.n_circ");
       return s;
     }
     default: {
@@ -458,6 +490,7 @@ IntegratorSpec parse_integrator(const Parser& p, const YAML::Node& n) {
   if (!n["name"]) p.fail(n, "integrator.name", "missing required key 'name' (e.g. name: em-galpha)");
   IntegratorSpec s;
   s.name = p.name(n["name"], "integrator.name");
+  s.where = p.where(n["name"], "");
   std::set<std::string> seen;
   for (auto it = n.begin(); it != n.end(); ++it) {
     const std::string key = p.string(it->first, "integrator");
@@ -467,6 +500,7 @@ IntegratorSpec parse_integrator(const Parser& p, const YAML::Node& n) {
     if (!it->second.IsScalar())
       p.fail(it->second, path, "integrator settings must be single values, got a " + node_kind(it->second));
     s.settings.emplace_back(key, it->second.Scalar());
+    s.setting_where.push_back(p.where(it->first, ""));
   }
   return s;
 }
@@ -477,6 +511,9 @@ TimeSpec parse_time(const Parser& p, const YAML::Node& n) {
   t.dt = p.positive(n["dt"], "time.dt");
   t.t_end = p.positive(n["t_end"], "time.t_end");
   if (t.dt > t.t_end) p.fail(n["dt"], "time.dt", "dt must not exceed t_end");
+  // A step count that no run can reach (and that would overflow the step counters) is a typo.
+  if (t.t_end / t.dt > 1e10)
+    p.fail(n["t_end"], "time.t_end", "t_end/dt is more than 1e10 steps; check t_end and dt");
   t.output_interval = t.dt;
   if (n["output_interval"]) {
     t.output_interval = p.positive(n["output_interval"], "time.output_interval");
@@ -581,7 +618,8 @@ CaseSpec parse_document(const Parser& p, const YAML::Node& root, const std::stri
 
 // ---------------------------------------------------------------------------------------------------
 const char* mesh_kind_name(const MeshSpec& mesh) {
-  static const char* names[] = {"rectangle", "cell_union", "cylindrical_panel", "hemisphere", "file"};
+  static const char* names[] = {"rectangle",      "cell_union",      "cylindrical_panel", "hemisphere",
+                                "file",           "cylinder_patch",  "closed_cylinder",   "slit_annulus"};
   return names[mesh.index()];
 }
 

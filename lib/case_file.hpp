@@ -16,6 +16,9 @@
 //              | cell_union            cells: [[i0,j0,i1,j1], ...], [cell]
 //              | cylindrical_panel     radius, angle, length, n_arc, n_axial
 //              | hemisphere            radius, hole_deg, quarter, n
+//              | cylinder_patch        radius, angle, length, n_arc, n_axial   (axis X through the origin)
+//              | closed_cylinder       radius, length, n_circ, n_axial
+//              | slit_annulus          r_inner, r_outer, n_radial, n_circ
 //     file: plate.msh                  Gmsh 4.1 (quad9); relative to the case file's folder
 //   material: {E, nu, rho, thickness, [shear_factor = 5/6]}
 //   sets:                              optional extra node sets, each exactly one of
@@ -72,13 +75,26 @@ struct HemisphereMeshSpec {
   bool quarter = false;
   int n = 0;
 };
+struct CylinderPatchMeshSpec {
+  double radius = 0, angle = 0, length = 0;
+  int n_arc = 0, n_axial = 0;
+};
+struct ClosedCylinderMeshSpec {
+  double radius = 0, length = 0;
+  int n_circ = 0, n_axial = 0;
+};
+struct SlitAnnulusMeshSpec {
+  double r_inner = 0, r_outer = 0;
+  int n_radial = 0, n_circ = 0;
+};
 struct MeshFileSpec {
   std::string path;  // absolute (resolved against the case file's folder)
 };
-using MeshSpec =
-    std::variant<RectangleMeshSpec, CellUnionMeshSpec, CylindricalPanelMeshSpec, HemisphereMeshSpec, MeshFileSpec>;
+using MeshSpec = std::variant<RectangleMeshSpec, CellUnionMeshSpec, CylindricalPanelMeshSpec, HemisphereMeshSpec,
+                              MeshFileSpec, CylinderPatchMeshSpec, ClosedCylinderMeshSpec, SlitAnnulusMeshSpec>;
 
-// "rectangle", "cell_union", "cylindrical_panel", "hemisphere" or "file".
+// "rectangle", "cell_union", "cylindrical_panel", "hemisphere", "file", "cylinder_patch",
+// "closed_cylinder" or "slit_annulus".
 const char* mesh_kind_name(const MeshSpec& mesh);
 
 // --- material ------------------------------------------------------------------------------------
@@ -154,6 +170,10 @@ struct DampingSpec {
 struct IntegratorSpec {
   std::string name;
   std::vector<std::pair<std::string, std::string>> settings;  // in file order, values as written
+  // "FILE:LINE" of the block and of each setting (parallel to `settings`), for errors that the
+  // integrator raises later (integrators/runs/case_integrator.hpp); empty for specs not read from a file.
+  std::string where;
+  std::vector<std::string> setting_where;
 };
 
 struct TimeSpec {

@@ -43,8 +43,8 @@ std::string available_sets(const Mesh& mesh) {
 const std::vector<int>& find_set(const Mesh& mesh, const std::string& name, const std::string& where) {
   auto it = mesh.node_sets.find(name);
   if (it == mesh.node_sets.end())
-    fail(where, "unknown set '" + name + "' (available: " + available_sets(mesh) +
-                    "; define it under 'sets:')");
+    fail(where, "unknown set '" + name + "' (define it under 'sets:' or use one below)\navailable: " +
+                    available_sets(mesh));
   return it->second;
 }
 
@@ -112,11 +112,10 @@ void resolve_case_sets(const CaseSpec& spec, Mesh& mesh, double mesh_size) {
         }
         if (best < 0 || best_d > tol) {
           std::ostringstream os;
-          os << "no node within tol = " << tol << " of the point " << fmt(s.point);
+          os << "no node within tol = " << tol << " of the point " << fmt(s.point) << " (correct the point or set 'tol')";
           if (best >= 0)
-            os << "; the nearest is node " << best << " at " << fmt(mesh.X[static_cast<size_t>(best)])
+            os << "\nthe nearest is node " << best << " at " << fmt(mesh.X[static_cast<size_t>(best)])
                << ", distance " << best_d;
-          os << " (correct the point or set 'tol')";
           fail(s.where + ".point", os.str());
         }
         nodes.push_back(best);
@@ -224,6 +223,12 @@ Mesh build_mesh(const CaseSpec& spec) {
             return make_cylindrical_panel(m.radius, m.angle, m.length, m.n_arc, m.n_axial);
           else if constexpr (std::is_same_v<T, HemisphereMeshSpec>)
             return make_hemisphere(m.radius, m.hole_deg, m.quarter, m.n);
+          else if constexpr (std::is_same_v<T, CylinderPatchMeshSpec>)
+            return make_cylinder_patch(m.radius, m.angle, m.length, m.n_arc, m.n_axial);
+          else if constexpr (std::is_same_v<T, ClosedCylinderMeshSpec>)
+            return make_closed_cylinder(m.radius, m.length, m.n_circ, m.n_axial);
+          else if constexpr (std::is_same_v<T, SlitAnnulusMeshSpec>)
+            return make_slit_annulus(m.r_inner, m.r_outer, m.n_radial, m.n_circ);
           else
             return read_gmsh(m.path);
         },

@@ -168,6 +168,10 @@ struct ElementBlock {
 Mesh read_gmsh(const std::string& path) {
   std::ifstream in(path);
   if (!in) throw std::runtime_error(path + ": cannot open the file for reading (check the path)");
+  return read_gmsh(in, path);
+}
+
+Mesh read_gmsh(std::istream& in, const std::string& path) {
   Lexer lex(in, path);
 
   bool have_format = false, have_nodes = false, have_elements = false;
@@ -192,8 +196,7 @@ Mesh read_gmsh(const std::string& path) {
       lex.next_int("the data size");
       if (version != "4.1")
         lex.fail("MSH version " + version +
-                 " is not supported; only MSH 4.1 ASCII is (export with 'gmsh -format msh41' or "
-                 "Mesh.MshFileVersion = 4.1)");
+                 " is not supported: export MSH 4.1 ASCII (gmsh -format msh41)");
       if (file_type != 0)
         lex.fail("binary MSH files are not supported; save as ASCII (Mesh.Binary = 0, no '-bin')");
       lex.expect("$EndMeshFormat");
@@ -287,10 +290,8 @@ Mesh read_gmsh(const std::string& path) {
         const int npe = nodes_per_element(blk.type);
         if (npe == 0)
           lex.fail("element type " + std::to_string(blk.type) + " (" + type_name(blk.type) +
-                   ") is not supported: only 9-node quadrangles (type 10) are supported for the shell "
-                   "mesh, plus points (15) and lines (1, 8) for physical groups. Generate it with "
-                   "'gmsh -2 -order 2' and Mesh.ElementOrder = 2, Mesh.SecondOrderIncomplete = 0, "
-                   "Mesh.RecombineAll = 1 (recombined quadrangles)");
+                   ") is not supported: only 9-node quadrangles (type 10) are\n"
+                   "gmsh -2 -order 2 with Mesh.RecombineAll = 1 and Mesh.SecondOrderIncomplete = 0");
         if (blk.type == 10 && blk.dim != 2)
           lex.fail("quad9 elements (type 10) must belong to a surface (entity dimension 2), found " +
                    std::to_string(blk.dim));
@@ -330,8 +331,8 @@ Mesh read_gmsh(const std::string& path) {
   used.erase(std::unique(used.begin(), used.end()), used.end());
   if (used.empty())
     lex.fail(
-        "no 9-node quadrangles (type 10) in the file; generate the surface mesh with 'gmsh -2 -order 2', "
-        "Mesh.SecondOrderIncomplete = 0 and Mesh.RecombineAll = 1");
+        "no 9-node quadrangles (type 10) in the file (how to make them below)\n"
+        "gmsh -2 -order 2 with Mesh.RecombineAll = 1 and Mesh.SecondOrderIncomplete = 0");
   std::unordered_map<long long, int> index;
   Mesh mesh;
   for (long long t : used) {

@@ -28,10 +28,13 @@
 
 #include "lib/mesh.hpp"
 
+#include <istream>
 #include <string>
 
 namespace shelldyn {
 
 Mesh read_gmsh(const std::string& path);
+// The same from a stream; `path` only labels error messages (used by fuzz/fuzz_gmsh_reader.cpp).
+Mesh read_gmsh(std::istream& in, const std::string& path);
 
 }  // namespace shelldyn

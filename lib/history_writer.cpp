@@ -1,5 +1,7 @@
 #include "lib/history_writer.hpp"
 
+#include <unistd.h>
+
 #include <cerrno>
 #include <cstring>
 #include <set>
@@ -20,6 +22,43 @@ HistoryWriter::HistoryWriter(const std::string& path, std::vector<std::string> e
   columns_ = history_standard_columns();
   columns_.insert(columns_.end(), extra_columns.begin(), extra_columns.end());
   columns_.insert(columns_.end(), monitor_columns.begin(), monitor_columns.end());
+  check_columns();
+  file_ = std::fopen(path.c_str(), "w");
+  if (!file_) throw std::runtime_error(path + ": cannot create history file: " + std::strerror(errno));
+  for (size_t k = 0; k < columns_.size(); ++k) std::fprintf(file_, "%s%s", k ? "," : "", columns_[k].c_str());
+  std::fputc('\n', file_);
+  if (std::fflush(file_) != 0) throw std::runtime_error(path_ + ": write error: " + std::strerror(errno));
+}
+
+HistoryWriter::HistoryWriter(const std::string& path, std::vector<std::string> extra_columns,
+                             std::vector<std::string> monitor_columns, long long keep_bytes)
+    : path_(path), num_extra_(extra_columns.size()), num_monitors_(monitor_columns.size()) {
+  columns_ = history_standard_columns();
+  columns_.insert(columns_.end(), extra_columns.begin(), extra_columns.end());
+  columns_.insert(columns_.end(), monitor_columns.begin(), monitor_columns.end());
+  check_columns();
+  std::string header;
+  for (size_t k = 0; k < columns_.size(); ++k) header += (k ? "," : "") + columns_[k];
+  std::FILE* in = std::fopen(path.c_str(), "rb");
+  if (!in) throw std::runtime_error(path + ": cannot reopen the history file to resume: " + std::strerror(errno));
+  std::string first;
+  for (int c; (c = std::fgetc(in)) != EOF && c != '\n';) first += static_cast<char>(c);
+  std::fseek(in, 0, SEEK_END);
+  const long size = std::ftell(in);
+  std::fclose(in);
+  if (first != header) throw std::runtime_error(path + ": header differs from this run's columns; cannot resume");
+  if (size < keep_bytes || keep_bytes < static_cast<long long>(header.size()) + 1)
+    throw std::runtime_error(path + ": shorter than at the checkpoint (" + std::to_string(size) + " < " +
+                             std::to_string(keep_bytes) + " bytes); cannot resume");
+  if (truncate(path.c_str(), static_cast<off_t>(keep_bytes)) != 0)
+    throw std::runtime_error(path + ": cannot cut the rows after the checkpoint: " + std::strerror(errno));
+  file_ = std::fopen(path.c_str(), "a");
+  if (!file_) throw std::runtime_error(path + ": cannot append to the history file: " + std::strerror(errno));
+}
+
+long long HistoryWriter::bytes() const { return file_ ? static_cast<long long>(std::ftell(file_)) : 0; }
+
+void HistoryWriter::check_columns() {
   std::set<std::string> seen;
   for (const auto& c : columns_) {
     if (c.empty() || c.find_first_of(",\"\r\n") != std::string::npos)
@@ -28,11 +67,6 @@ HistoryWriter::HistoryWriter(const std::string& path, std::vector<std::string> e
     if (!seen.insert(c).second)
       throw std::invalid_argument("history.csv: column '" + c + "' appears twice (rename the monitor or extra column)");
   }
-  file_ = std::fopen(path.c_str(), "w");
-  if (!file_) throw std::runtime_error(path + ": cannot create history file: " + std::strerror(errno));
-  for (size_t k = 0; k < columns_.size(); ++k) std::fprintf(file_, "%s%s", k ? "," : "", columns_[k].c_str());
-  std::fputc('\n', file_);
-  std::fflush(file_);
 }
 
 HistoryWriter::~HistoryWriter() {
@@ -53,7 +87,8 @@ void HistoryWriter::write(const HistoryRow& r) {
   for (double v : r.monitors) std::fprintf(file_, ",%.17g", v);
   std::fputc('\n', file_);
   if (std::fflush(file_) != 0 || std::ferror(file_))
-    throw std::runtime_error(path_ + ": write error: " + std::strerror(errno));
+    throw std::runtime_error(path_ + ": cannot write history.csv: " +
+                             (errno == ENOSPC ? std::string("the disk is full (free space and rerun)") : std::strerror(errno)));
 }
 
 }  // namespace shelldyn

@@ -36,6 +36,11 @@ class HistoryWriter {
   // repeats another column.
   HistoryWriter(const std::string& path, std::vector<std::string> extra_columns,
                 std::vector<std::string> monitor_columns);
+  // Resume (checkpoint restart): keeps the first `keep_bytes` bytes of an existing `path` (the rows
+  // up to the checkpoint), drops the rest and appends from there. Throws std::runtime_error if the
+  // file is shorter or its header differs from these columns.
+  HistoryWriter(const std::string& path, std::vector<std::string> extra_columns,
+                std::vector<std::string> monitor_columns, long long keep_bytes);
   ~HistoryWriter();
   HistoryWriter(const HistoryWriter&) = delete;
   HistoryWriter& operator=(const HistoryWriter&) = delete;
@@ -46,8 +51,11 @@ class HistoryWriter {
 
   const std::vector<std::string>& columns() const { return columns_; }
   const std::string& path() const { return path_; }
+  // Bytes written so far (header included): the resume position of a checkpoint.
+  long long bytes() const;
 
  private:
+  void check_columns();
   std::string path_;
   std::FILE* file_ = nullptr;
   size_t num_extra_ = 0, num_monitors_ = 0;

@@ -392,3 +392,128 @@ Mesh make_hemisphere(double radius, double hole_deg, bool quarter, int n) {
 }
 
 }  // namespace shelldyn
+
+namespace shelldyn {
+
+Mesh make_cylinder_patch(double radius, double angle, double length, int n_arc, int n_axial) {
+  const std::string gen = "make_cylinder_patch";
+  require_positive(gen, "radius", radius);
+  require_positive(gen, "length", length);
+  require_count(gen, "n_arc", n_arc);
+  require_count(gen, "n_axial", n_axial);
+  if (!(std::isfinite(angle) && angle > 0.0 && angle <= kPi))
+    bad_parameter(gen, "parameter 'angle' = " + str(angle) + " rad is invalid; it must lie in (0, pi]");
+  if (!(angle / n_arc < kPi / 2))
+    bad_parameter(gen, "each element spans angle/n_arc = " + str(angle / n_arc) + " rad; it must be < pi/2: increase 'n_arc'");
+  const std::int64_t NI = 2 * static_cast<std::int64_t>(n_axial) + 1, NJ = 2 * static_cast<std::int64_t>(n_arc) + 1;
+  require_int_nodes(gen, NI * NJ);
+  Mesh m;
+  const int ni = static_cast<int>(NI), nj = static_cast<int>(NJ);
+  auto id = [ni](int I, int J) { return J * ni + I; };
+  m.X.resize(static_cast<size_t>(ni) * nj);
+  // I -> X, J -> psi: e_X x (0, cos psi, -sin psi) = (0, sin psi, cos psi), the outward radial direction.
+  for (int J = 0; J < nj; ++J) {
+    const double psi = angle * double(J) / double(nj - 1);
+    const double y = J == 0 ? 0.0 : radius * std::sin(psi), z = radius * std::cos(psi);
+    for (int I = 0; I < ni; ++I) m.X[id(I, J)] = Vec3(lerp(0.0, length, double(I) / (ni - 1)), y, z);
+  }
+  add_grid_elements(m, n_axial, n_arc, id);
+  auto& x0 = m.node_sets["x0"];
+  auto& x1 = m.node_sets["x1"];
+  for (int J = 0; J < nj; ++J) {
+    x0.push_back(id(0, J));
+    x1.push_back(id(ni - 1, J));
+  }
+  auto& a0 = m.node_sets["arc0"];
+  auto& a1 = m.node_sets["arc1"];
+  for (int I = 0; I < ni; ++I) {
+    a0.push_back(id(I, 0));
+    a1.push_back(id(I, nj - 1));
+  }
+  m.node_sets["corner_x0_arc0"] = {id(0, 0)};
+  m.node_sets["corner_x0_arc1"] = {id(0, nj - 1)};
+  m.node_sets["corner_x1_arc0"] = {id(ni - 1, 0)};
+  m.node_sets["corner_x1_arc1"] = {id(ni - 1, nj - 1)};
+  for (auto& kv : m.node_sets) sort_unique(kv.second);
+  add_all_sets(m);
+  return m;
+}
+
+Mesh make_closed_cylinder(double radius, double length, int n_circ, int n_axial) {
+  const std::string gen = "make_closed_cylinder";
+  require_positive(gen, "radius", radius);
+  require_positive(gen, "length", length);
+  require_count(gen, "n_axial", n_axial);
+  if (n_circ < 4) bad_parameter(gen, "parameter 'n_circ' = " + std::to_string(n_circ) + " is invalid; it must be >= 4");
+  const std::int64_t NI = 2 * static_cast<std::int64_t>(n_axial) + 1, NJ = 2 * static_cast<std::int64_t>(n_circ);
+  require_int_nodes(gen, NI * NJ);
+  Mesh m;
+  const int ni = static_cast<int>(NI), nj = static_cast<int>(NJ);
+  auto id = [ni, nj](int I, int J) { return (J % nj) * ni + I; };  // the seam theta = 2 pi is theta = 0
+  m.X.resize(static_cast<size_t>(ni) * nj);
+  for (int J = 0; J < nj; ++J) {
+    const double th = 2.0 * kPi * double(J) / double(nj);
+    for (int I = 0; I < ni; ++I)
+      m.X[id(I, J)] = Vec3(lerp(0.0, length, double(I) / (ni - 1)), radius * std::sin(th), radius * std::cos(th));
+  }
+  add_grid_elements(m, n_axial, n_circ, id);
+  auto& x0 = m.node_sets["x0"];
+  auto& x1 = m.node_sets["x1"];
+  for (int J = 0; J < nj; ++J) {
+    x0.push_back(id(0, J));
+    x1.push_back(id(ni - 1, J));
+  }
+  auto& top = m.node_sets["top"];
+  for (int I = 0; I < ni; ++I) top.push_back(id(I, 0));
+  if (nj % 2 == 0) {
+    auto& bottom = m.node_sets["bottom"];
+    for (int I = 0; I < ni; ++I) bottom.push_back(id(I, nj / 2));
+  }
+  for (auto& kv : m.node_sets) sort_unique(kv.second);
+  add_all_sets(m);
+  return m;
+}
+
+Mesh make_slit_annulus(double r_inner, double r_outer, int n_radial, int n_circ) {
+  const std::string gen = "make_slit_annulus";
+  require_positive(gen, "r_inner", r_inner);
+  require_positive(gen, "r_outer", r_outer);
+  require_count(gen, "n_radial", n_radial);
+  if (!(r_outer > r_inner)) bad_parameter(gen, "needs r_outer > r_inner (got " + str(r_inner) + ", " + str(r_outer) + ")");
+  if (n_circ < 3) bad_parameter(gen, "parameter 'n_circ' = " + std::to_string(n_circ) + " is invalid; it must be >= 3");
+  const std::int64_t NI = 2 * static_cast<std::int64_t>(n_radial) + 1, NJ = 2 * static_cast<std::int64_t>(n_circ) + 1;
+  require_int_nodes(gen, NI * NJ);
+  Mesh m;
+  const int ni = static_cast<int>(NI), nj = static_cast<int>(NJ);
+  auto id = [ni](int I, int J) { return J * ni + I; };
+  m.X.resize(static_cast<size_t>(ni) * nj);
+  // I -> r, J -> theta in [0, 2 pi]: e_r x e_theta = +Z. The slit edges theta = 0 and 2 pi are separate nodes.
+  for (int J = 0; J < nj; ++J) {
+    const double th = 2.0 * kPi * double(J) / double(nj - 1);
+    const double c = J == nj - 1 ? 1.0 : std::cos(th), s = (J == 0 || J == nj - 1) ? 0.0 : std::sin(th);
+    for (int I = 0; I < ni; ++I) {
+      const double r = lerp(r_inner, r_outer, double(I) / (ni - 1));
+      m.X[id(I, J)] = Vec3(r * c, r * s, 0.0);
+    }
+  }
+  add_grid_elements(m, n_radial, n_circ, id);
+  auto& s0 = m.node_sets["slit_start"];
+  auto& s1 = m.node_sets["slit_end"];
+  for (int I = 0; I < ni; ++I) {
+    s0.push_back(id(I, 0));
+    s1.push_back(id(I, nj - 1));
+  }
+  auto& in = m.node_sets["inner"];
+  auto& out = m.node_sets["outer"];
+  for (int J = 0; J < nj; ++J) {
+    in.push_back(id(0, J));
+    out.push_back(id(ni - 1, J));
+  }
+  m.node_sets["point_A"] = {id(0, nj - 1)};
+  m.node_sets["point_B"] = {id(ni - 1, nj - 1)};
+  for (auto& kv : m.node_sets) sort_unique(kv.second);
+  add_all_sets(m);
+  return m;
+}
+
+}  // namespace shelldyn

@@ -40,4 +40,24 @@ Mesh make_cylindrical_panel(double radius, double angle, double length, int n_ar
 // "sym_x0" (phi = 90 deg, plane X = 0).
 Mesh make_hemisphere(double radius, double hole_deg, bool quarter, int n);
 
+// Cylindrical patch for quarter / octant models, axis along X through the origin (the shell sits at its
+// natural height): X in [0, length], Y = R sin(psi), Z = R cos(psi), psi in [0, angle] (0 < angle <= pi);
+// the straight edge psi = 0 lies in the plane Y = 0 and the arc X = 0 in the plane X = 0. n_arc elements
+// along psi, n_axial along X; normal outward (away from the axis).
+// Node sets: "x0" (X = 0), "x1" (X = length), "arc0" (psi = 0, plane Y = 0), "arc1" (psi = angle),
+// "corner_x0_arc0", "corner_x0_arc1", "corner_x1_arc0", "corner_x1_arc1".
+Mesh make_cylinder_patch(double radius, double angle, double length, int n_arc, int n_axial);
+
+// Closed cylinder, axis along X: X in [0, length], Y = R sin(theta), Z = R cos(theta), theta in [0, 2 pi)
+// with the seam merged; n_circ >= 4 elements around, n_axial along; normal outward.
+// Node sets: "x0", "x1" (the end rings), "top" (theta = 0: Y = 0, Z = R), "bottom" (theta = pi).
+Mesh make_closed_cylinder(double radius, double length, int n_circ, int n_axial);
+
+// Slit annular plate in the plane Z = 0 (Sze, Liu & Lo 2004 §3.3), r in [r_inner, r_outer], theta in
+// [0, 2 pi] with the slit along +X: the nodes at theta = 0 and theta = 2 pi are distinct. n_radial
+// elements across, n_circ >= 3 around; normal +Z.
+// Node sets: "slit_start" (theta = 0), "slit_end" (theta = 2 pi), "inner", "outer", "point_A"
+// (r_inner on slit_end), "point_B" (r_outer on slit_end).
+Mesh make_slit_annulus(double r_inner, double r_outer, int n_radial, int n_circ);
+
 }  // namespace shelldyn

@@ -352,6 +352,14 @@ Vec3 Model::director(const State& s, int node) const {
   return shelldyn::director(s.u.segment<2>(DofMap::dof(node, 3)), s.charts[static_cast<size_t>(node)]);
 }
 
+void Model::adopt_charts(const std::vector<DirectorChart>& charts) {
+  if (static_cast<int>(charts.size()) != mesh_.num_nodes())
+    throw std::invalid_argument("adopt_charts: " + std::to_string(charts.size()) + " charts for " +
+                                std::to_string(mesh_.num_nodes()) + " nodes");
+  for (const auto& c : charts) check_chart(c);
+  dofs_.resolve(charts);
+}
+
 int Model::rechart(State& s, double hysteresis) {
   int switched = 0;
   for (int i = 0; i < mesh_.num_nodes(); ++i) {

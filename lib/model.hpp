@@ -128,6 +128,9 @@ class Model final : public SemiDiscreteSystem {
   // Re-selects director charts between increments (docs/theory.md §2.3), converting u, v, a, and
   // re-resolves director constraints. Returns the number of nodes whose chart switched.
   int rechart(State& s, double hysteresis = 1.0) override;
+  // Adopts the charts of a state restored from a checkpoint: re-resolves the director constraints for
+  // them (what rechart() does after a switch). Throws std::invalid_argument on a count mismatch.
+  void adopt_charts(const std::vector<DirectorChart>& charts);
   double chart_margin(const State& s) const override;
 
  private:

@@ -1,7 +1,12 @@
 #include "lib/run_info.hpp"
 
 #include <Eigen/Core>
+#include <nlohmann/json.hpp>
 
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -25,34 +30,14 @@ std::string eigen_version() {
 }
 
 std::string json_quote(const std::string& s) {
-  std::string out = "\"";
-  for (unsigned char c : s) {
-    switch (c) {
-      case '"': out += "\\\""; break;
-      case '\\': out += "\\\\"; break;
-      case '\b': out += "\\b"; break;
-      case '\f': out += "\\f"; break;
-      case '\n': out += "\\n"; break;
-      case '\r': out += "\\r"; break;
-      case '\t': out += "\\t"; break;
-      default:
-        if (c < 0x20) {
-          char buf[8];
-          std::snprintf(buf, sizeof buf, "\\u%04x", c);
-          out += buf;
-        } else {
-          out += static_cast<char>(c);  // UTF-8 passes through unchanged
-        }
-    }
-  }
-  return out + "\"";
+  // error_handler replace: invalid UTF-8 becomes U+FFFD instead of an exception (a case file or a
+  // command line may hold any bytes).
+  return nlohmann::json(s).dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
 }
 
 std::string json_number(double v) {
   if (!std::isfinite(v)) return "null";
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.17g", v);
-  return buf;
+  return nlohmann::json(v).dump();  // shortest representation that reads back to the same double
 }
 
 void JsonFields::set_encoded(const std::string& key, std::string json) {
@@ -70,56 +55,15 @@ void JsonFields::set(const std::string& key, bool value) { set_encoded(key, valu
 
 namespace {
 
-// Minimal pretty printer: objects and arrays are opened/closed explicitly; commas are tracked per level.
-class JsonOut {
- public:
-  std::string str() const { return os_.str(); }
+using Json = nlohmann::ordered_json;  // keys in insertion order: the document reads top-down
 
-  void open_object(const std::string& key = "") { open(key, '{'); }
-  void open_array(const std::string& key = "") { open(key, '['); }
-  void close_object() { close('}'); }
-  void close_array() { close(']'); }
-  // A member (inside an object, key non-empty) or an element (inside an array, key empty).
-  void value(const std::string& key, const std::string& encoded) {
-    item(key);
-    os_ << encoded;
-  }
-  void str(const std::string& key, const std::string& s) { value(key, json_quote(s)); }
-  void num(const std::string& key, double v) { value(key, json_number(v)); }
-  void integer(const std::string& key, long long v) { value(key, std::to_string(v)); }
-  void boolean(const std::string& key, bool v) { value(key, v ? "true" : "false"); }
-  void vec3(const std::string& key, const Eigen::Vector3d& v) {
-    value(key, "[" + json_number(v.x()) + ", " + json_number(v.y()) + ", " + json_number(v.z()) + "]");
-  }
-  void fields(const std::string& key, const JsonFields& f) {
-    open_object(key);
-    for (const auto& [k, v] : f.entries()) value(k, v);
-    close_object();
-  }
-
- private:
-  void item(const std::string& key) {
-    if (!first_.empty()) {
-      if (!first_.back()) os_ << ",";
-      first_.back() = false;
-      os_ << "\n" << std::string(2 * first_.size(), ' ');
-    }
-    if (!key.empty()) os_ << json_quote(key) << ": ";
-  }
-  void open(const std::string& key, char bracket) {
-    item(key);
-    os_ << bracket;
-    first_.push_back(true);
-  }
-  void close(char bracket) {
-    const bool was_empty = first_.back();
-    first_.pop_back();
-    if (!was_empty) os_ << "\n" << std::string(2 * first_.size(), ' ');
-    os_ << bracket;
-  }
-  std::ostringstream os_;
-  std::vector<bool> first_;
-};
+Json number(double v) { return std::isfinite(v) ? Json(v) : Json(nullptr); }
+Json vec3(const Eigen::Vector3d& v) { return Json::array({number(v.x()), number(v.y()), number(v.z())}); }
+Json fields(const JsonFields& f) {
+  Json j = Json::object();
+  for (const auto& [k, v] : f.entries()) j[k] = Json::parse(v);
+  return j;
+}
 
 const char* set_kind_name(SetSpec::Kind k) {
   switch (k) {
@@ -131,31 +75,35 @@ const char* set_kind_name(SetSpec::Kind k) {
   return "?";
 }
 
-void write_mesh(JsonOut& j, const MeshSpec& mesh) {
-  j.open_object("mesh");
+Json mesh_json(const MeshSpec& mesh) {
+  Json j = Json::object();
   if (const auto* m = std::get_if<MeshFileSpec>(&mesh)) {
-    j.str("file", m->path);
-  } else {
-    j.str("generator", mesh_kind_name(mesh));
-    if (const auto* r = std::get_if<RectangleMeshSpec>(&mesh)) {
-      j.num("a", r->a), j.num("b", r->b), j.integer("nx", r->nx), j.integer("ny", r->ny);
-      j.num("x0", r->x0), j.num("y0", r->y0);
-    } else if (const auto* c = std::get_if<CellUnionMeshSpec>(&mesh)) {
-      j.open_array("cells");
-      for (const auto& r : c->cells)
-        j.value("", "[" + std::to_string(r[0]) + ", " + std::to_string(r[1]) + ", " + std::to_string(r[2]) + ", " +
-                        std::to_string(r[3]) + "]");
-      j.close_array();
-      j.num("cell", c->cell);
-    } else if (const auto* p = std::get_if<CylindricalPanelMeshSpec>(&mesh)) {
-      j.num("radius", p->radius), j.num("angle", p->angle), j.num("length", p->length);
-      j.integer("n_arc", p->n_arc), j.integer("n_axial", p->n_axial);
-    } else if (const auto* h = std::get_if<HemisphereMeshSpec>(&mesh)) {
-      j.num("radius", h->radius), j.num("hole_deg", h->hole_deg), j.boolean("quarter", h->quarter);
-      j.integer("n", h->n);
-    }
+    j["file"] = m->path;
+    return j;
   }
-  j.close_object();
+  j["generator"] = mesh_kind_name(mesh);
+  if (const auto* r = std::get_if<RectangleMeshSpec>(&mesh)) {
+    j["a"] = number(r->a), j["b"] = number(r->b), j["nx"] = r->nx, j["ny"] = r->ny;
+    j["x0"] = number(r->x0), j["y0"] = number(r->y0);
+  } else if (const auto* c = std::get_if<CellUnionMeshSpec>(&mesh)) {
+    j["cells"] = Json::array();
+    for (const auto& r : c->cells) j["cells"].push_back(Json::array({r[0], r[1], r[2], r[3]}));
+    j["cell"] = number(c->cell);
+  } else if (const auto* p = std::get_if<CylindricalPanelMeshSpec>(&mesh)) {
+    j["radius"] = number(p->radius), j["angle"] = number(p->angle), j["length"] = number(p->length);
+    j["n_arc"] = p->n_arc, j["n_axial"] = p->n_axial;
+  } else if (const auto* h = std::get_if<HemisphereMeshSpec>(&mesh)) {
+    j["radius"] = number(h->radius), j["hole_deg"] = number(h->hole_deg), j["quarter"] = h->quarter;
+    j["n"] = h->n;
+  } else if (const auto* q = std::get_if<CylinderPatchMeshSpec>(&mesh)) {
+    j["radius"] = number(q->radius), j["angle"] = number(q->angle), j["length"] = number(q->length);
+    j["n_arc"] = q->n_arc, j["n_axial"] = q->n_axial;
+  } else if (const auto* c2 = std::get_if<ClosedCylinderMeshSpec>(&mesh)) {
+    j["radius"] = number(c2->radius), j["length"] = number(c2->length), j["n_circ"] = c2->n_circ, j["n_axial"] = c2->n_axial;
+  } else if (const auto* a = std::get_if<SlitAnnulusMeshSpec>(&mesh)) {
+    j["r_inner"] = number(a->r_inner), j["r_outer"] = number(a->r_outer), j["n_radial"] = a->n_radial, j["n_circ"] = a->n_circ;
+  }
+  return j;
 }
 
 std::string utc_now() {
@@ -170,141 +118,118 @@ std::string utc_now() {
 }  // namespace
 
 std::string run_json(const CaseSpec& c, const RunInfo& info) {
-  JsonOut j;
-  j.open_object();
-  j.str("status", info.status);
-  j.str("created_utc", utc_now());
-  if (!info.command.empty()) j.str("command", info.command);
-  j.open_object("versions");
-  j.str("shelldyn", shelldyn_version());
-  j.str("sundials", info.sundials_version.empty() ? "not used" : info.sundials_version);
-  j.str("eigen", eigen_version());
+  Json j = Json::object();
+  j["status"] = info.status;
+  j["created_utc"] = utc_now();
+  if (!info.command.empty()) j["command"] = info.command;
+  Json& v = j["versions"];
+  v["shelldyn"] = shelldyn_version();
+  v["sundials"] = info.sundials_version.empty() ? "not used" : info.sundials_version;
+  v["eigen"] = eigen_version();
+  v["nlohmann_json"] = std::to_string(NLOHMANN_JSON_VERSION_MAJOR) + "." + std::to_string(NLOHMANN_JSON_VERSION_MINOR) +
+                       "." + std::to_string(NLOHMANN_JSON_VERSION_PATCH);
 #ifdef __VERSION__
-  j.str("compiler", __VERSION__);
+  v["compiler"] = __VERSION__;
 #endif
-  j.close_object();
+  if (!info.overrides.empty()) j["command_line_overrides"] = fields(info.overrides);
 
-  j.open_object("case");
-  j.str("name", c.name);
-  j.str("description", c.description);
-  j.str("source", c.source.empty() ? "" : std::filesystem::absolute(c.source).lexically_normal().string());
-  write_mesh(j, c.mesh);
-  j.open_object("material");
-  j.num("E", c.material.E), j.num("nu", c.material.nu), j.num("rho", c.material.rho);
-  j.num("thickness", c.material.thickness), j.num("shear_factor", c.material.shear_factor);
-  j.close_object();
-  j.open_object("sets");
+  Json& cs = j["case"];
+  cs["name"] = c.name;
+  cs["description"] = c.description;
+  cs["source"] = c.source.empty() ? "" : std::filesystem::absolute(c.source).lexically_normal().string();
+  cs["mesh"] = mesh_json(c.mesh);
+  cs["material"] = {{"E", number(c.material.E)}, {"nu", number(c.material.nu)}, {"rho", number(c.material.rho)},
+                    {"thickness", number(c.material.thickness)}, {"shear_factor", number(c.material.shear_factor)}};
+  Json& sets = cs["sets"] = Json::object();
   for (const auto& s : c.sets) {
-    j.open_object(s.name);
-    j.str("kind", set_kind_name(s.kind));
+    Json e = {{"kind", set_kind_name(s.kind)}};
     switch (s.kind) {
       case SetSpec::Kind::Point:
-        j.vec3("point", s.point);
-        if (s.tol >= 0) j.num("tol", s.tol);
+        e["point"] = vec3(s.point);
+        if (s.tol >= 0) e["tol"] = number(s.tol);
         break;
       case SetSpec::Kind::Box:
-        j.vec3("min", s.box_min), j.vec3("max", s.box_max);
+        e["min"] = vec3(s.box_min), e["max"] = vec3(s.box_max);
         break;
       case SetSpec::Kind::Nodes:
-        j.open_array("nodes");
-        for (int n : s.nodes) j.integer("", n);
-        j.close_array();
+        e["nodes"] = s.nodes;
         break;
       case SetSpec::Kind::Union:
-        j.open_array("union");
-        for (const auto& m : s.members) j.str("", m);
-        j.close_array();
+        e["union"] = s.members;
         break;
     }
-    j.close_object();
+    sets[s.name] = std::move(e);
   }
-  j.close_object();
-  j.open_array("boundary_conditions");
+  Json& bcs = cs["boundary_conditions"] = Json::array();
   for (const auto& bc : c.boundary_conditions) {
-    j.open_object();
-    j.str("set", bc.set);
-    j.open_array("fix");
-    for (Fix f : bc.fix) j.str("", fix_name(f));
-    j.close_array();
-    j.close_object();
+    Json fix = Json::array();
+    for (Fix f : bc.fix) fix.push_back(fix_name(f));
+    bcs.push_back({{"set", bc.set}, {"fix", std::move(fix)}});
   }
-  j.close_array();
-  j.open_object("initial_velocity");
-  j.str("set", c.initial_velocity.set);
-  if (!c.initial_velocity.field.empty()) j.str("field", c.initial_velocity.field);
-  if (!c.initial_velocity_more.empty()) j.integer("further_entries", static_cast<long long>(c.initial_velocity_more.size()));
-  j.vec3("translation", c.initial_velocity.translation);
-  j.vec3("angular", c.initial_velocity.angular);
-  if (c.initial_velocity.about_centroid)
-    j.str("about", "centroid");
-  else
-    j.vec3("about", c.initial_velocity.about);
-  j.close_object();
-  j.open_array("loads");
+  Json& iv = cs["initial_velocity"];
+  iv["set"] = c.initial_velocity.set;
+  if (!c.initial_velocity.field.empty()) iv["field"] = c.initial_velocity.field;
+  if (!c.initial_velocity_more.empty()) iv["further_entries"] = c.initial_velocity_more.size();
+  iv["translation"] = vec3(c.initial_velocity.translation);
+  iv["angular"] = vec3(c.initial_velocity.angular);
+  iv["about"] = c.initial_velocity.about_centroid ? Json("centroid") : vec3(c.initial_velocity.about);
+  Json& loads = cs["loads"] = Json::array();
   for (const auto& l : c.loads) {
-    j.open_object();
-    j.str("set", l.set), j.str("type", load_type_name(l.type)), j.vec3("direction", l.direction);
-    j.num("amplitude", l.amplitude), j.str("distribution", load_distribution_name(l.distribution));
-    j.open_object("function");
-    j.str("type", l.function.kind_name());
-    for (const auto& [k, v] : l.function.parameters()) j.num(k, v);
+    Json f = {{"type", l.function.kind_name()}};
+    for (const auto& [k, x] : l.function.parameters()) f[k] = number(x);
     if (l.function.kind() == TimeFunction::Kind::Table) {
-      j.open_array("points");
-      for (const auto& [t, f] : l.function.table_points()) j.value("", "[" + json_number(t) + ", " + json_number(f) + "]");
-      j.close_array();
+      Json pts = Json::array();
+      for (const auto& [t, x] : l.function.table_points()) pts.push_back(Json::array({number(t), number(x)}));
+      f["points"] = std::move(pts);
     }
-    j.close_object();
-    j.close_object();
+    loads.push_back({{"set", l.set}, {"type", load_type_name(l.type)}, {"direction", vec3(l.direction)},
+                     {"amplitude", number(l.amplitude)}, {"distribution", load_distribution_name(l.distribution)},
+                     {"function", std::move(f)}});
   }
-  j.close_array();
-  j.open_object("damping");
-  j.num("mass", c.damping.mass), j.num("stiffness", c.damping.stiffness);
-  j.close_object();
-  j.open_object("integrator");
-  j.str("name", c.integrator.name);
-  for (const auto& [k, v] : c.integrator.settings) j.str(k, v);
-  j.close_object();
-  j.open_object("time");
-  j.num("dt", c.time.dt), j.num("t_end", c.time.t_end), j.num("output_interval", c.time.output_interval);
-  j.integer("num_steps", c.time.num_steps());
-  j.close_object();
-  j.open_object("output");
-  j.boolean("vtu", c.output.vtu), j.integer("vtu_every", c.output.vtu_every), j.boolean("history", c.output.history);
-  j.close_object();
-  j.open_array("monitors");
+  cs["damping"] = {{"mass", number(c.damping.mass)}, {"stiffness", number(c.damping.stiffness)}};
+  Json& integ = cs["integrator"];
+  integ["name"] = c.integrator.name;
+  for (const auto& [k, x] : c.integrator.settings) integ[k] = x;
+  cs["time"] = {{"dt", number(c.time.dt)}, {"t_end", number(c.time.t_end)},
+                {"output_interval", number(c.time.output_interval)}, {"num_steps", c.time.num_steps()}};
+  cs["output"] = {{"vtu", c.output.vtu}, {"vtu_every", c.output.vtu_every}, {"history", c.output.history}};
+  Json& mons = cs["monitors"] = Json::array();
   for (const auto& m : c.monitors) {
-    j.open_object();
-    j.str("name", m.name), j.str("set", m.set), j.str("quantity", monitor_quantity_name(m.quantity));
-    j.str("reduce", monitor_reduce_name(m.reduce));
-    if (m.has_axis) {
-      j.open_object("axis");
-      j.vec3("point", m.axis_point), j.vec3("direction", m.axis_direction);
-      j.close_object();
-    }
-    j.close_object();
+    Json e = {{"name", m.name}, {"set", m.set}, {"quantity", monitor_quantity_name(m.quantity)},
+              {"reduce", monitor_reduce_name(m.reduce)}};
+    if (m.has_axis) e["axis"] = {{"point", vec3(m.axis_point)}, {"direction", vec3(m.axis_direction)}};
+    mons.push_back(std::move(e));
   }
-  j.close_array();
-  j.close_object();  // case
 
-  j.fields("discretization", info.discretization);
-  j.fields("summary", info.summary);
-  j.close_object();
-  return j.str() + "\n";
+  j["discretization"] = fields(info.discretization);
+  j["summary"] = fields(info.summary);
+  if (!info.checkpoint.empty()) j["checkpoint"] = fields(info.checkpoint);
+  return j.dump(2, ' ', false, Json::error_handler_t::replace) + "\n";
+}
+
+void write_text_atomically(const std::string& path, const std::string& text, const std::string& what) {
+  const std::string tmp = path + ".tmp";
+  auto fail = [&](const std::string& step, int err) {
+    std::remove(tmp.c_str());  // never leave a stale .tmp behind
+    const std::string reason = err == ENOSPC ? "the disk is full (free space and rerun)"
+                               : err == EDQUOT ? "the disk quota is exceeded"
+                               : err == EROFS  ? "the file system is read-only"
+                               : err == EACCES ? "permission denied (choose a writable folder)"
+                                               : std::string(std::strerror(err));
+    throw std::runtime_error(path + ": cannot " + step + " " + what + ": " + reason);
+  };
+  std::FILE* f = std::fopen(tmp.c_str(), "wb");
+  if (!f) fail("create", errno);
+  errno = 0;
+  const bool written = std::fwrite(text.data(), 1, text.size(), f) == text.size() && std::fflush(f) == 0 &&
+                       fsync(fileno(f)) == 0;
+  const int err = errno ? errno : EIO;
+  if (std::fclose(f) != 0 || !written) fail("write", written ? (errno ? errno : EIO) : err);
+  if (std::rename(tmp.c_str(), path.c_str()) != 0) fail("replace", errno);
 }
 
 void write_run_json(const std::string& path, const CaseSpec& spec, const RunInfo& info) {
-  const std::string text = run_json(spec, info);
-  const std::string tmp = path + ".tmp";
-  {
-    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-    if (!out) throw std::runtime_error(path + ": cannot create run.json (check the output folder)");
-    out << text;
-    out.close();
-    if (!out) throw std::runtime_error(path + ": write error");
-  }
-  std::error_code ec;
-  std::filesystem::rename(tmp, path, ec);
-  if (ec) throw std::runtime_error(path + ": cannot replace run.json: " + ec.message());
+  write_text_atomically(path, run_json(spec, info), "run.json");
 }
 
 }  // namespace shelldyn

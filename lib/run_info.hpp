@@ -1,8 +1,11 @@
 // run.json: makes a result folder explain itself (architecture.md §5) — the resolved case settings,
 // the software versions, the run status and a summary of key numbers.
 //
-// The JSON is written by hand (no JSON dependency); strings are escaped per RFC 8259 and non-finite
-// numbers become null (JSON has no NaN/inf).
+// The document is built with nlohmann-json (Debian's nlohmann-json3-dev): strings are escaped per
+// RFC 8259 (invalid UTF-8 replaced by U+FFFD), numbers in the shortest form that reads back exactly,
+// non-finite numbers as null (JSON has no NaN/inf). Files are replaced atomically (temporary + fsync +
+// rename); an error names the file and its cause ("the disk is full", "read-only", ...) and removes
+// the temporary.
 #pragma once
 
 #include "lib/case_file.hpp"
@@ -45,17 +48,22 @@ struct RunInfo {
   std::string sundials_version;  // passed in by the caller (SUNDIALS lives in integrators/); may be empty
   JsonFields discretization;     // e.g. nodes, elements, dofs, constrained_dofs, total_mass
   JsonFields summary;            // e.g. steps, final energy, drift, wall time
+  JsonFields overrides;          // command-line flags that changed the case ("command_line_overrides")
+  JsonFields checkpoint;         // the last checkpoint written (file, t, step), if any
 };
 
 // Encodes a string as a JSON string literal (with quotes).
 std::string json_quote(const std::string& s);
-// Encodes a number with %.17g; NaN and infinities become null.
+// Encodes a number in its shortest round-trip form; NaN and infinities become null.
 std::string json_number(double v);
 
 // The whole document as text (pretty-printed, 2-space indentation).
 std::string run_json(const CaseSpec& spec, const RunInfo& info);
 // Writes run_json() to `path` via a temporary file and a rename (a reader never sees half a file).
-// Throws std::runtime_error on I/O errors.
+// Throws std::runtime_error on I/O errors ("PATH: cannot write run.json: the disk is full ...").
 void write_run_json(const std::string& path, const CaseSpec& spec, const RunInfo& info);
+
+// The same for any text file; `what` names it in errors.
+void write_text_atomically(const std::string& path, const std::string& text, const std::string& what);
 
 }  // namespace shelldyn

@@ -34,15 +34,25 @@ class File {
   explicit File(const std::string& path) : path_(path), f_(std::fopen(path.c_str(), "w")) {
     if (!f_) throw std::runtime_error(path + ": cannot create file: " + std::strerror(errno));
   }
-  ~File() {
-    if (f_) std::fclose(f_);
+  ~File() {  // not closed: an exception interrupted the write; leave no half-written file behind
+    if (f_) {
+      std::fclose(f_);
+      std::remove(path_.c_str());
+    }
   }
   std::FILE* get() const { return f_; }
   void close() {
-    const bool bad = std::ferror(f_) != 0;
+    errno = 0;
+    const bool bad = std::fflush(f_) != 0 || std::ferror(f_) != 0;
+    const int err = errno;
     const int rc = std::fclose(f_);
     f_ = nullptr;
-    if (bad || rc != 0) throw std::runtime_error(path_ + ": write error: " + std::strerror(errno));
+    if (bad || rc != 0) {
+      const int e = err ? err : errno;
+      std::remove(path_.c_str());
+      throw std::runtime_error(path_ + ": cannot write: " +
+                               (e == ENOSPC ? std::string("the disk is full (free space and rerun)") : std::strerror(e)));
+    }
   }
 
  private:

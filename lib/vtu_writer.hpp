@@ -46,6 +46,8 @@ class PvdWriter {
   // relative to the .pvd's folder, e.g. "fields/step_000010.vtu". Throws std::runtime_error on I/O errors.
   void add(double time, const std::string& file);
   const std::vector<std::pair<double, std::string>>& entries() const { return entries_; }
+  // Resume (checkpoint restart): the entries up to the checkpoint; the file is rewritten at the next add().
+  void restore(std::vector<std::pair<double, std::string>> entries) { entries_ = std::move(entries); }
   const std::string& path() const { return path_; }
 
  private:

@@ -12,12 +12,15 @@ PACKAGES=(
   libopenblas0-pthread                 # fast BLAS for CHOLMOD's supernodal factorization
   libeigen3-dev                        # Eigen 3.4
   libyaml-cpp-dev libcli11-dev         # case files, command line
+  nlohmann-json3-dev                   # run.json and checkpoints (lib/run_info, integrators/checkpoint)
   libspectra-dev                       # Spectra: shift-invert Lanczos of `shelldyn modes` (header-only)
   libgtest-dev libgmock-dev            # unit tests
   libbenchmark-dev                     # performance programs
   python3 python3-meshio               # VTU round-trip check in the test suite
   python3-matplotlib                   # plots of the apps and `shelldyn compare` (scripts/plot_*.py)
 )
+# Not listed (opt-in tools): clang-14 libclang-rt-14-dev for scripts/fuzz.sh (libFuzzer); .ci/run
+# installs them itself when SHELLDYN_CI_SANITIZE=1.
 
 if [ "${1:-}" = "--with-mpi" ]; then
   PACKAGES+=(libopenmpi-dev openmpi-bin)   # optional: SHELLDYN_WITH_MPI, `mpirun -n P shelldyn compare`

@@ -10,4 +10,4 @@ bash scripts/install-deps.sh
 bash scripts/build.sh
 echo
 echo "=== main job: the flying L-shaped plate (FLP-prov), em-galpha, loads on until t = 5 s, free flight to t = 6 s"
-build/bin/shelldyn run apps/cases/flying-plate.yaml --t-end 6 -o results/flying-plate/em-galpha
+build/bin/shelldyn run apps/cases/flying-plate.yaml --t-end 6 -o results/flying-plate/em-galpha --overwrite

@@ -4,6 +4,9 @@
 #include "integrators/sundials/sundials_support.hpp"
 #include "lib/assembler.hpp"
 
+#include <fcntl.h>
+#include <unistd.h>
+
 #include <cstdio>  // arkode_butcher.h uses FILE without including it (docs/dependencies.md §2.2)
 #include <arkode/arkode_arkstep.h>
 #include <arkode/arkode_butcher_dirk.h>
@@ -58,14 +61,24 @@ class ArkodeIntegrator final : public Integrator {
       if (max_nonlin_ < 1) throw std::invalid_argument(name_ + ": max_nonlin_iters must be >= 1");
     }
     // Validate the table now, so that a typo is a settings error, not a failure at initialize().
-    ARKodeButcherTable B = implicit ? ARKodeButcherTable_LoadDIRKByName(table_.c_str())
-                                    : ARKodeButcherTable_LoadERKByName(table_.c_str());
+    ARKodeButcherTable B = nullptr;
+    {  // SUNDIALS prints its own "[ARKODE ERROR] ... Unknown Butcher table" lines: keep stderr to one line
+      std::fflush(stderr);
+      const int saved = dup(2);
+      const int null = open("/dev/null", O_WRONLY);
+      if (saved >= 0 && null >= 0) dup2(null, 2);
+      B = implicit ? ARKodeButcherTable_LoadDIRKByName(table_.c_str()) : ARKodeButcherTable_LoadERKByName(table_.c_str());
+      std::fflush(stderr);
+      if (saved >= 0 && null >= 0) dup2(saved, 2);
+      if (null >= 0) close(null);
+      if (saved >= 0) close(saved);
+    }
     if (B == nullptr)
       throw std::invalid_argument(name_ + ": unknown " + (implicit ? "DIRK" : "ERK") + " table '" + table_ +
-                                  "' (SUNDIALS 6.4.1 names, e.g. " +
+                                  "' (SUNDIALS 6.4.1 names)\ne.g. " +
                                   (implicit ? "ARKODE_ESDIRK547L2SA_7_4_5, ARKODE_SDIRK_5_3_4"
                                             : "ARKODE_DORMAND_PRINCE_7_4_5, ARKODE_VERNER_8_5_6") +
-                                  "; see docs/dependencies.md §4.4)");
+                                  "; full list: docs/dependencies.md §4.4");
     const bool embedded = B->d != nullptr;
     ARKodeButcherTable_Free(B);
     if (!embedded && !fixed_)
@@ -80,6 +93,22 @@ class ArkodeIntegrator final : public Integrator {
   std::vector<std::pair<std::string, std::string>> settings() const override { return resolved_; }
   double external_work() const override { return w_; }
 
+  // Checkpoint by re-initialization (docs/architecture.md "Checkpoints and resume"): only W_ext at the
+  // last output time is saved; restore() restarts SUNDIALS from the saved State as after a chart
+  // event. The step-size and order history is lost, so a resumed run agrees with an uninterrupted one
+  // to the tolerances (rtol, atol), not bitwise.
+  void save(IntegratorCheckpoint& c) const override {
+    c.exact = false;
+    c.scalars["W_ext"] = w_out_;
+  }
+  void restore(SemiDiscreteSystem& system, State& state, const IntegratorCheckpoint& c) override {
+    if (mem_ == nullptr) throw std::logic_error(name() + ": restore() before initialize()");
+    sys_ = &system;
+    w_ = w_out_ = c.scalar("W_ext");
+    StepReport ignored;
+    restart_from(state, ignored);
+  }
+
   void initialize(SemiDiscreteSystem& system, State& state) override {
     free_ark();
     sys_ = &system;
@@ -89,7 +118,8 @@ class ArkodeIntegrator final : public Integrator {
     const Index N = 2 * n_ + 1;
     if (system.chart_margin(state) < 0.0) system.rechart(state);
     fos_->acceleration(state.t, state, state.a);
-    w_ = 0.0;
+    w_ = w_out_ = 0.0;
+    stop_hit_ = false;
     t_ = state.t;
     work_ = state;
     y_ = make_serial_vector(N, *ctx_);
@@ -139,6 +169,12 @@ class ArkodeIntegrator final : public Integrator {
       const int flag = ARKStepEvolve(mem_, t_out, y_.get(), &tret, ARK_NORMAL);
       if (flag < 0) {
         add_counters(rep);
+        if (stop_hit_) {  // stop request (signal, --max-wall): state is still the last output state
+          stop_hit_ = false;
+          std::ostringstream os;
+          os << name() << ": stopped on request at t = " << tret << " (state kept at t = " << state.t << ")";
+          throw RunInterrupted(os.str());
+        }
         fail(flag, tret);
       }
       t_ = tret;
@@ -172,6 +208,7 @@ class ArkodeIntegrator final : public Integrator {
     ARKStepGetLastStep(mem_, &h);
     rep.last_dt = h;
     rep.factorizations = factorizations() - fact0;
+    w_out_ = w_;
     rep.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
     return rep;
   }
@@ -369,6 +406,10 @@ class ArkodeIntegrator final : public Integrator {
   // --- RHS, root and post-step callbacks: no exception crosses them ---
   static int rhs(sunrealtype t, N_Vector y, N_Vector ydot, void* ud) {
     auto* self = static_cast<ArkodeIntegrator*>(ud);
+    if (self->stop_requested()) {  // signal or --max-wall: abandon the interval (unrecoverable)
+      self->stop_hit_ = true;
+      return -1;
+    }
     try {
       const Index n = self->n_;
       const double* yv = N_VGetArrayPointer(y);
@@ -451,6 +492,8 @@ class ArkodeIntegrator final : public Integrator {
   Index n_ = 0;
   State work_;
   double t_ = 0.0, w_ = 0.0;
+  double w_out_ = 0.0;      // W_ext at the end of the last advance() (checkpoints)
+  bool stop_hit_ = false;   // a callback saw stop_requested()
   Eigen::VectorXd a_;
 
   // Newton solver of arkode-dirk

@@ -60,6 +60,22 @@ class IdaBdf final : public Integrator {
   std::vector<std::pair<std::string, std::string>> settings() const override { return resolved_; }
   double external_work() const override { return w_; }
 
+  // Checkpoint by re-initialization (docs/architecture.md "Checkpoints and resume"): only W_ext at the
+  // last output time is saved; restore() restarts SUNDIALS from the saved State as after a chart
+  // event. The step-size and order history is lost, so a resumed run agrees with an uninterrupted one
+  // to the tolerances (rtol, atol), not bitwise.
+  void save(IntegratorCheckpoint& c) const override {
+    c.exact = false;
+    c.scalars["W_ext"] = w_out_;
+  }
+  void restore(SemiDiscreteSystem& system, State& state, const IntegratorCheckpoint& c) override {
+    if (mem_ == nullptr) throw std::logic_error(name() + ": restore() before initialize()");
+    sys_ = &system;
+    w_ = w_out_ = c.scalar("W_ext");
+    StepReport ignored;
+    restart_from(state, ignored);
+  }
+
   void initialize(SemiDiscreteSystem& system, State& state) override {
     free_ida();
     sys_ = &system;
@@ -76,7 +92,8 @@ class IdaBdf final : public Integrator {
     // A director past its chart's margin at the start: switch first (docs/theory.md §2.3).
     if (system.chart_margin(state) < 0.0) system.rechart(state);
     fos_->acceleration(state.t, state, state.a);
-    w_ = 0.0;
+    w_ = w_out_ = 0.0;
+    stop_hit_ = false;
     t_ = state.t;
     work_ = state;
 
@@ -131,6 +148,12 @@ class IdaBdf final : public Integrator {
       const int flag = IDASolve(mem_, t_out, &tret, y_.get(), yp_.get(), IDA_NORMAL);
       if (flag < 0) {
         add_counters(rep);
+        if (stop_hit_) {  // stop request (signal, --max-wall): state is still the last output state
+          stop_hit_ = false;
+          std::ostringstream os;
+          os << name() << ": stopped on request at t = " << tret << " (state kept at t = " << state.t << ")";
+          throw RunInterrupted(os.str());
+        }
         fail(flag, tret);
       }
       t_ = tret;
@@ -161,6 +184,7 @@ class IdaBdf final : public Integrator {
     IDAGetLastStep(mem_, &h);
     rep.last_dt = h;
     rep.factorizations = sun_linear_solver_backend(LS_.get()).stats().factorizations - fact0;
+    w_out_ = w_;
     rep.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
     return rep;
   }
@@ -294,6 +318,10 @@ class IdaBdf final : public Integrator {
   // --- C callbacks: no exception crosses them ---
   static int residual(sunrealtype t, N_Vector y, N_Vector yp, N_Vector r, void* ud) {
     auto* self = static_cast<IdaBdf*>(ud);
+    if (self->stop_requested()) {  // signal or --max-wall: abandon the interval (unrecoverable for IDA)
+      self->stop_hit_ = true;
+      return -1;
+    }
     try {
       const Index n = self->n_;
       const double* yv = N_VGetArrayPointer(y);
@@ -394,6 +422,8 @@ class IdaBdf final : public Integrator {
   Index n_ = 0;
   State work_;  // current charts; u, v, a are scratch inside callbacks
   double t_ = 0.0, w_ = 0.0;
+  double w_out_ = 0.0;      // W_ext at the end of the last advance() (checkpoints)
+  bool stop_hit_ = false;   // a callback saw stop_requested()
   Eigen::VectorXd a_, r_, fext_;
   SparseMatrix K_, M_, G_v_, big_;
   IdaCounters base_;

@@ -15,7 +15,7 @@ namespace shelldyn {
 
 GeneralizedAlphaParameters generalized_alpha_parameters(double rho_inf) {
   if (!(rho_inf >= 0.0 && rho_inf <= 1.0))
-    throw std::invalid_argument("rho_inf = " + std::to_string(rho_inf) + " is outside [0, 1]");
+    throw std::invalid_argument((std::ostringstream() << "rho_inf = " << rho_inf << " is outside [0, 1]").str());
   // docs/theory.md §6.1 (Chung–Hulbert; Kuhl–Crisfield GEMM convention x_{n+1−α} = (1−α)x_{n+1} + α x_n).
   GeneralizedAlphaParameters p;
   p.alpha_m = (2.0 * rho_inf - 1.0) / (rho_inf + 1.0);
@@ -33,14 +33,19 @@ class NewmarkFamily final : public Integrator {
  public:
   NewmarkFamily(Scheme scheme, std::string name, IntegratorSettings& s, double dt)
       : scheme_(scheme), name_(std::move(name)), dt_(dt) {
+    auto g = [](double x) {
+      char b[32];
+      std::snprintf(b, sizeof b, "%.10g", x);
+      return std::string(b);
+    };
     if (!(dt > 0.0) || !std::isfinite(dt)) throw std::invalid_argument(name_ + ": time step dt must be > 0");
     if (scheme_ == Scheme::Newmark) {
       p_.alpha_m = p_.alpha_f = 0.0;
       p_.beta = s.get("beta", 0.25);
       p_.gamma = s.get("gamma", 0.5);
       if (!(p_.beta > 0.0) || !(p_.gamma >= 0.5))
-        throw std::invalid_argument(name_ + ": need beta > 0 and gamma >= 0.5 (got beta = " +
-                                    std::to_string(p_.beta) + ", gamma = " + std::to_string(p_.gamma) + ")");
+        throw std::invalid_argument(name_ + ": need beta > 0 and gamma >= 0.5 (got beta = " + g(p_.beta) + ", gamma = " +
+                                    g(p_.gamma) + ")");
     } else {
       p_ = generalized_alpha_parameters(s.get("rho_inf", 1.0));
     }
@@ -108,13 +113,9 @@ class NewmarkFamily final : public Integrator {
     max_cuts_ = s.get("max_cuts", 0);
     hysteresis_ = s.get("hysteresis", 1.0);
     if (!(nopt_.energy_tol > 0.0) || nopt_.max_iters < 1 || nopt_.min_iters < 0 || max_cuts_ < 0 || hysteresis_ < 1.0)
-      throw std::invalid_argument(name_ + ": need cc_tol > 0, max_iters >= 1, min_iters >= 0, max_cuts >= 0, hysteresis >= 1");
+      throw std::invalid_argument(name_ + ": out-of-range Newton settings (limits below)\nneed cc_tol > 0, max_iters >= 1, "
+                                  "min_iters >= 0, max_cuts >= 0, hysteresis >= 1");
     resolved_ = s.resolved();
-    auto g = [](double x) {
-      char b[32];
-      std::snprintf(b, sizeof b, "%.10g", x);
-      return std::string(b);
-    };
     resolved_.insert(resolved_.begin(), {{"dt", g(dt_)}, {"alpha_m", g(p_.alpha_m)}, {"alpha_f", g(p_.alpha_f)},
                                          {"beta", g(p_.beta)}, {"gamma", g(p_.gamma)}});
   }
@@ -123,6 +124,42 @@ class NewmarkFamily final : public Integrator {
   std::vector<std::pair<std::string, std::string>> settings() const override { return resolved_; }
   double external_work() const override { return work_; }
   double damping_work() const override { return damping_work_; }
+
+  // Checkpoint (docs/architecture.md "Checkpoints and resume"): besides the State (u, v, a, charts)
+  // a step depends on W_ext, the step counter (messages), the last step size (modified Newton
+  // refreshes K̄ when it changes) and, with modified Newton, the K̄ in use and the iterations done with
+  // it. restore() makes the next setup replay that K̄ (same values, hence the same factorization)
+  // and resume the refresh count, so the continued run is bitwise the uninterrupted one.
+  void save(IntegratorCheckpoint& c) const override {
+    if (!newton_) throw std::logic_error(name_ + ": save() before initialize()");
+    c.exact = true;
+    c.scalars["W_ext"] = work_;
+    c.scalars["W_damp"] = damping_work_;
+    c.scalars["steps"] = static_cast<double>(steps_);
+    c.scalars["last_h"] = last_h_;
+    const int since = nopt_.modified ? newton_->iterations_since_setup() : -1;
+    c.scalars["newton_since_setup"] = since;
+    if (since >= 0) c.vectors["kbar"] = Eigen::Map<const Eigen::VectorXd>(kbar_.data(), static_cast<Index>(kbar_.size()));
+  }
+
+  void restore(SemiDiscreteSystem& sys, State& s, const IntegratorCheckpoint& c) override {
+    if (!newton_) throw std::logic_error(name_ + ": restore() before initialize()");
+    if (s.u.size() != sys.num_dofs() || s.v.size() != sys.num_dofs() || s.a.size() != sys.num_dofs())
+      throw std::runtime_error(name_ + ": checkpoint state has the wrong size for this model");
+    work_ = c.scalar("W_ext");
+    damping_work_ = c.scalar("W_damp");
+    steps_ = static_cast<long>(c.scalar("steps"));
+    last_h_ = c.scalar("last_h");
+    const int since = static_cast<int>(c.scalar("newton_since_setup"));
+    replay_kbar_ = false;
+    if (nopt_.modified && since >= 0) {
+      const Eigen::VectorXd& k = c.vector("kbar");
+      if (k.size() != sys.pattern()->nnz()) throw std::runtime_error(name_ + ": checkpoint K̄ has the wrong size");
+      kbar_.assign(k.data(), k.data() + k.size());
+      replay_kbar_ = true;
+      newton_->resume_after_setup(since);
+    }
+  }
 
   void initialize(SemiDiscreteSystem& sys, State& s) override {
     const Index n = sys.num_dofs();
@@ -158,6 +195,7 @@ class NewmarkFamily final : public Integrator {
       double h = std::min(dt_, t_out - s.t);
       if (t_out - (s.t + h) < 1e-9 * dt_) h = t_out - s.t;  // land exactly on t_out
       step_with_cuts(sys, s, h, 0, rep);
+      if (stop_requested()) break;  // at a step boundary: the driver checkpoints and stops
     }
     rep.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return rep;
@@ -189,7 +227,11 @@ class NewmarkFamily final : public Integrator {
     rep.chart_switches += sys.rechart(s, hysteresis_);  // §2.3: between steps only
     // K̄ depends on h (modified Newton). Steps that land on an output time differ from dt in the last bits
     // (t_out − t); that is no reason to throw a factorization away.
-    if (std::abs(h - last_h_) > 1e-8 * h) newton_->invalidate_jacobian();
+    if (std::abs(h - last_h_) > 1e-8 * h) {
+      newton_->invalidate_jacobian();
+      if (replay_kbar_) newton_->resume_after_setup(0);  // a saved K̄ for another h is of no use
+      replay_kbar_ = false;
+    }
     last_h_ = h;
     if (full_newton && !full_newton_) {
       NewtonOptions full = nopt_;
@@ -252,7 +294,14 @@ class NewmarkFamily final : public Integrator {
       zero_constrained(sys.dofs(), r);
       if (!rr.allFinite()) throw std::runtime_error("non-finite residual");
     };
+    bool replayed = false;
     auto jacobian = [&](const double* u, SparseMatrix& J) {
+      if (replay_kbar_ && !full_newton) {  // first setup after restore(): the saved K̄, not a new one
+        J.values = kbar_;
+        replay_kbar_ = false;
+        replayed = true;
+        return;
+      }
       const Eigen::Map<const Eigen::VectorXd> uu(u, n);
       midpoint_state(u);
       sys.mass(umid_, charts, M_);
@@ -276,6 +325,7 @@ class NewmarkFamily final : public Integrator {
       for (size_t k = 0; k < J.values.size(); ++k) J.values[k] = du * M_.values[k] + (1 - af) * K_.values[k];
       sys.add_damping_matrix(cu, J);  // ∂(C u̇_mid)/∂u_{n+1} (docs/theory.md §8.5)
       apply_dirichlet(sys.dofs(), J, nullptr);
+      if (nopt_.modified && !full_newton) kbar_ = J.values;  // for save()
     };
 
     Eigen::VectorXd u = un_;  // predictor u_{n+1}^(0) = u_n (§6.4)
@@ -299,8 +349,9 @@ class NewmarkFamily final : public Integrator {
     const NewtonSolver::Result r = newton.solve(u.data(), residual, jacobian, nullptr, uscale_.data(), hook);
     if (full_newton) newton_->invalidate_jacobian();  // the modified solver's K̄ is stale now
     rep.nonlinear_iterations += r.iterations;
-    rep.linear_setups += r.jacobian_evals;
-    rep.factorizations += r.factorizations;
+    // A replayed K̄ (restore()) is the uninterrupted run's matrix, not a new setup: not counted.
+    rep.linear_setups += r.jacobian_evals - (replayed ? 1 : 0);
+    rep.factorizations += r.factorizations - (replayed ? 1 : 0);
     rep.rhs_evaluations += r.residual_evals;
     rep.residual_norm = r.fnorm;
     rep.energy_ratio = r.energy_ratio;
@@ -348,6 +399,8 @@ class NewmarkFamily final : public Integrator {
   bool newmark_predictor_ = false;
   double last_h_ = 0.0;
   long steps_ = 0;
+  std::vector<double> kbar_;   // the modified solver's last K̄ (checkpoints)
+  bool replay_kbar_ = false;   // restore(): the next setup of the modified solver uses kbar_
 };
 
 }  // namespace

@@ -84,6 +84,7 @@ struct NewtonSolver::Impl {
   // Modified Newton bookkeeping (across solve() calls).
   bool have_jacobian = false, force_setup = false;
   int since_setup = 0;
+  int resume_since_setup = -1;  // checkpoint restart: since_setup after the next setup (-1: 0)
 
   ~Impl() {
     if (kin) KINFree(&kin);
@@ -189,6 +190,11 @@ NewtonSolver& NewtonSolver::operator=(NewtonSolver&&) noexcept = default;
 const NewtonOptions& NewtonSolver::options() const { return impl_->opt; }
 const LinearSolver& NewtonSolver::linear_solver() const { return sun_linear_solver_backend(impl_->LS.get()); }
 void NewtonSolver::invalidate_jacobian() { impl_->force_setup = true; }
+int NewtonSolver::iterations_since_setup() const {
+  const Impl& s = *impl_;
+  return s.have_jacobian && !s.force_setup ? s.since_setup : -1;
+}
+void NewtonSolver::resume_after_setup(int k) { impl_->resume_since_setup = k; }
 
 NewtonSolver::Result NewtonSolver::solve(double* u, const Residual& residual, const Jacobian& jacobian,
                                          const double* fscale, const double* uscale,
@@ -293,7 +299,8 @@ NewtonSolver::Result NewtonSolver::solve(double* u, const Residual& residual, co
     if (s.jacobian_evals > jac0) {
       s.have_jacobian = true;
       s.force_setup = false;
-      s.since_setup = 0;
+      s.since_setup = s.resume_since_setup > 0 ? s.resume_since_setup : 0;
+      s.resume_since_setup = -1;
     }
     s.since_setup += static_cast<int>(nni);
 

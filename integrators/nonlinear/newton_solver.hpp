@@ -163,6 +163,13 @@ class NewtonSolver {
   // matrix changes for reasons the solver cannot see, e.g. a new time step size in K̄).
   void invalidate_jacobian();
 
+  // Checkpoint/restart of modified Newton (integrators/checkpoint/): iterations done with the current
+  // Jacobian, or -1 when the next iteration refreshes it anyway. resume_after_setup(k): after the next
+  // Jacobian setup continue counting from k instead of 0, so that a restored solver (whose first setup
+  // replays the saved matrix) refreshes at the same iterations as the solver that was saved.
+  int iterations_since_setup() const;
+  void resume_after_setup(int k);
+
   const NewtonOptions& options() const;
   const LinearSolver& linear_solver() const;  // stats(): analyses stay at 1 for a fixed pattern
 

@@ -1,51 +1,101 @@
-// Nonlinear statics by load-factor stepping with KINSOL Newton (issue: CR9 element + static solver).
+// Nonlinear statics: load control, arc-length path following and displacement control
+// (docs/statics.md).
 //
-// The load factor λ plays the role of time: F_ext(λ) = model.external(λ, ...), so a case file's load
-// time functions define the load path (a `ramp` with t1 = 1 gives F_ext ∝ λ). Each increment solves
-//     R(u) = F_int(u) − F_ext(λ, u) = 0     (constrained DOFs: identity rows, zero residual)
-// with K(u) − ∂F_ext/∂u (symmetric part) as the Jacobian. Director charts are re-selected between
-// increments (docs/theory.md §2.3), never inside a Newton solve. A failed increment (no convergence,
-// or a director overshoot |q| ≥ 1 caught by the element, §2.1 guard) is cut in half and retried from
-// the last converged state; after easy increments the increment grows again, up to the initial size.
+// The load parameter λ plays the role of time: F_ext(λ, u) = model.external(λ, u, ...), so a case file's
+// load time functions define the load path (a `ramp` with t1 = 1 gives F_ext ∝ λ; with other functions
+// λ is a pseudo-time and messages say so, see `parameter_name`). Every solve is a full Newton iteration on
+//     R(u, λ) = F_int(u) − F_ext(λ, u) = 0     (constrained DOFs: identity rows, zero residual)
+// with the tangent K(u) − sym ∂F_ext/∂u, factorized by the project's LinearSolver (an LDLᵀ back-end by
+// default, whose negative pivots give the inertia of the tangent), and the scale-aware ConvergenceTest of
+// integrators/nonlinear/path_following.hpp. Director charts are re-selected between steps
+// (docs/theory.md §2.3), never inside a Newton solve.
+//
+// Controls:
+//   load:          λ stepped to the multiples of `increment` (reported levels); a failed increment
+//                  (no convergence, or the director overshoot guard |q| ≥ 1 of docs/theory.md §2.1) is
+//                  halved and retried, and grows again after easy increments. Cannot pass a limit point:
+//                  a step that passes one is REPORTED (critical_points), never silent: the inertia of the
+//                  converged tangent changes, or the Newton iterates of the step crossed an indefinite
+//                  tangent, or the converged increment is longer than `jump_ratio` × its tangent prediction
+//                  K_n⁻¹ΔF (the solution jumped to a remote branch: snap-through).
+//   arc_length:    Crisfield's cylindrical constraint ‖Δd‖₂ = Δl on the translations (path_following.hpp),
+//                  with the usual root choice; predictor along K⁻¹F̂ (F̂ = ∂F_ext/∂λ) with the sign of
+//                  its projection on the previous increment; Δl adapted to `target_iterations` and halved
+//                  on failure. Δl of the first step makes its predictor Δλ = `increment`.
+//   displacement:  the DOF `control_dof` is prescribed in steps of `increment` (length units), λ follows.
+// Critical points (arc length, displacement): a reversal of λ is a limit point (its load estimated by a
+// parabola λ(s) through the three points around the extremum); a change of the number of negative pivots
+// of the converged tangent not followed by a reversal within two steps is a bifurcation point (branch
+// switching is not done: the solver stays on the primary path). The last arc-length step is solved under
+// load control at exactly lambda_end.
 #pragma once
 
-#include "integrators/nonlinear/newton_solver.hpp"
+#include "integrators/nonlinear/path_following.hpp"
 #include "lib/model.hpp"
 #include "lib/state.hpp"
 
 #include <functional>
+#include <limits>
 #include <string>
+#include <vector>
 
 namespace shelldyn {
 
+enum class PathControl { load, arc_length, displacement };
+PathControl parse_path_control(const std::string& name);  // "load" | "arc_length" | "displacement"
+const char* path_control_name(PathControl c);
+
 struct StaticOptions {
-  double increment = 0.05;       // initial (and largest) load-factor increment
-  double min_increment = 1e-6;   // give up below this
-  double growth = 1.5;           // increment growth after an easy increment
-  int easy_iterations = 6;       // an increment converged in at most this many iterations is easy
+  PathControl control = PathControl::load;
+  double increment = 0.05;        // load: Δλ per level; arc_length: first predictor Δλ; displacement: Δ per step
+  double min_increment = 1e-6;    // load: give up below this Δλ; others: below this fraction of the first Δl / Δ
+  double growth = 1.5;            // load: increment growth after an easy increment; arc: max Δl growth per step
+  int easy_iterations = 6;        // load: an increment converged in at most this many iterations is easy
+  int target_iterations = 5;      // arc length: Δl ← Δl·sqrt(target/iterations), within [1/2, growth]
+  double max_arc_factor = 4.0;    // arc length / displacement: Δl ≤ this × the first Δl
+  int max_steps = 1000;           // arc length / displacement: give up after this many steps
+  int max_iters = 30;             // Newton iterations per step
+  double jump_ratio = 5.0;        // load: a converged increment longer than this × the tangent prediction is a jump
+  ConvergenceTest convergence;
+  std::string linear_solver = "eigen-ldlt";
   double rechart_hysteresis = 1.0;
-  NewtonOptions newton;          // KINSOL settings (full Newton by default)
+  Index control_dof = -1;         // displacement control: the prescribed DOF
+  double displacement_end = std::numeric_limits<double>::quiet_NaN();  // displacement: stop there
+  std::string parameter_name = "load factor";  // "pseudo-time t" when the loads are not proportional to λ
 };
 
-// One reported load level (a multiple of `increment`, or the final load factor). When increments had
-// to be cut, several converged sub-increments lead to one level; the counts cover all of them.
+// One reported point of the path (load control: a load level; other controls: every step).
 struct StaticIncrement {
-  int step = 0;                  // levels reached so far
+  int step = 0;
   double load_factor = 0.0;
-  int newton_iterations = 0;     // over the sub-increments since the previous level
-  int chart_switches = 0;        // director charts switched since the previous level
-  int cuts = 0;                  // failed attempts since the previous level
-  double residual_norm = 0.0;    // KINSOL's final scaled residual norm
+  int newton_iterations = 0;     // since the previous reported point
+  int chart_switches = 0;
+  int cuts = 0;                  // failed attempts since the previous reported point
+  double residual_norm = 0.0;    // ‖R_free‖₂ at the converged point
+  double arc_length = 0.0;       // cumulative ‖Δd‖₂ along the path
+  long negative_pivots = 0;      // inertia of the converged tangent (-1: back-end cannot tell)
+  std::string event;             // "", "limit point", "bifurcation point", "critical point", "snap-through"
+};
+
+struct CriticalPoint {
+  int step = 0;                  // reported point at which it was detected (just past it)
+  double load_factor = 0.0;      // λ at that point
+  double estimate = 0.0;         // limit point: parabolic estimate of the maximum λ; else = load_factor
+  std::string kind;              // as StaticIncrement::event
+  long pivots_before = 0, pivots_after = 0;
+  std::string note;              // one line for logs and run.json
 };
 
 struct StaticReport {
-  int levels = 0;                // reported load levels
+  int levels = 0;                // reported points
   int increments = 0;            // converged (sub-)increments
   int failed_attempts = 0;
   int newton_iterations = 0;
-  int jacobian_evaluations = 0;
+  int jacobian_evaluations = 0;  // factorizations
   int chart_switches = 0;
   double wall_seconds = 0.0;
+  double max_load_factor = 0.0;
+  std::vector<CriticalPoint> critical_points;
 };
 
 class StaticSolver {
@@ -53,15 +103,16 @@ class StaticSolver {
   StaticSolver(Model& model, StaticOptions options);
 
   using Observer = std::function<void(const State&, const StaticIncrement&)>;
-  // Advances `state` (whose t is the current load factor) to load factor lambda_end. Calls `observer`
-  // at every load level (the multiples of `increment` and lambda_end). Throws std::runtime_error naming the load factor, the increment
-  // and KINSOL's message when the increment falls below min_increment.
+  // Advances `state` (whose t is the current λ). Load control: to λ = lambda_end exactly. Arc length and
+  // displacement control: until λ ≥ lambda_end, the controlled DOF reaches displacement_end, or max_steps
+  // (the last is an error). Calls `observer` at every reported point. Throws std::runtime_error naming
+  // the step, λ, the increment and the failed convergence test with its values when the step size falls
+  // below its minimum.
   StaticReport solve(State& state, double lambda_end, const Observer& observer = {});
 
  private:
   Model& model_;
   StaticOptions options_;
-  NewtonSolver newton_;
 };
 
 }  // namespace shelldyn

@@ -211,7 +211,8 @@ std::vector<CompareRun> expand_compare_runs(const CompareOptions& o) {
     {  // adaptive = has an rtol setting; inherited = the case's settings this integrator understands
       base.adaptive = !settings_understood_by(base.integrator, {{"rtol", ""}}).empty();
       for (const auto& [k, v] : settings_understood_by(base.integrator, case_spec.integrator.settings)) {
-        const bool overridden = std::any_of(base.overrides.begin(), base.overrides.end(), [&](const auto& kv) { return kv.first == k; });
+        const std::string& key = k;  // (clang: C++17 lambdas cannot capture structured bindings)
+        const bool overridden = std::any_of(base.overrides.begin(), base.overrides.end(), [&](const auto& kv) { return kv.first == key; });
         if (!overridden) base.inherited.emplace_back(k, v);
       }
     }

@@ -72,7 +72,7 @@ std::unique_ptr<Integrator> make_integrator(IntegratorSettings& settings, double
   if (it == registry().end()) {
     std::string names;
     for (const auto& n : integrator_names()) names += (names.empty() ? "" : ", ") + n;
-    throw std::invalid_argument("unknown integrator '" + settings.name() + "' (available: " + names + ")");
+    throw std::invalid_argument("unknown integrator '" + settings.name() + "' (see the list below)\navailable: " + names);
   }
   auto integrator = it->second.factory(settings, dt);
   settings.finish();

@@ -1,4 +1,5 @@
 #include "integrators/runs/run_driver.hpp"
+#include "integrators/runs/case_integrator.hpp"
 #include "integrators/runs/registry.hpp"
 
 #include "integrators/sundials/sundials_info.hpp"
@@ -12,10 +13,16 @@
 
 #include <chrono>
 #include <cmath>
+#include <csignal>
 #include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <iostream>
 #include <limits>
 #include <memory>
+#include <sstream>
 
 namespace shelldyn {
 namespace {
@@ -49,32 +56,204 @@ void fill_summary_json(JsonFields& j, const RunSummary& s) {
   j.set("wall_s", s.wall_seconds);
 }
 
+// --- signals ---------------------------------------------------------------------------------------
+volatile std::sig_atomic_t g_stop_signal = 0;
+
+extern "C" void on_stop_signal(int sig) {
+  if (g_stop_signal != 0) _exit(128 + sig);  // second signal: leave at once (async-signal-safe)
+  g_stop_signal = sig;
+}
+
+// Installs the handlers for the lifetime of a run and restores the previous ones.
+class SignalGuard {
+ public:
+  explicit SignalGuard(bool on) : on_(on) {
+    if (!on_) return;
+    g_stop_signal = 0;
+    struct sigaction sa {};
+    sa.sa_handler = on_stop_signal;
+    sigemptyset(&sa.sa_mask);
+    sa.sa_flags = 0;
+    sigaction(SIGINT, &sa, &old_int_);
+    sigaction(SIGTERM, &sa, &old_term_);
+  }
+  ~SignalGuard() {
+    if (!on_) return;
+    sigaction(SIGINT, &old_int_, nullptr);
+    sigaction(SIGTERM, &old_term_, nullptr);
+  }
+  SignalGuard(const SignalGuard&) = delete;
+  SignalGuard& operator=(const SignalGuard&) = delete;
+
+ private:
+  bool on_;
+  struct sigaction old_int_ {}, old_term_ {};
+};
+
+std::string g17(double x) {
+  char b[40];
+  std::snprintf(b, sizeof b, "%.10g", x);
+  return b;
+}
+
+std::string read_file(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return {};
+  return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+}
+
+std::string encode_pairs(const std::vector<std::pair<std::string, std::string>>& kv) {
+  std::string s;
+  for (const auto& [k, v] : kv) s += k + "=" + v + "\n";
+  return s;
+}
+
+std::vector<std::pair<std::string, std::string>> decode_pairs(const std::string& s) {
+  std::vector<std::pair<std::string, std::string>> kv;
+  std::istringstream in(s);
+  for (std::string line; std::getline(in, line);) {
+    const auto eq = line.find('=');
+    if (eq != std::string::npos) kv.emplace_back(line.substr(0, eq), line.substr(eq + 1));
+  }
+  return kv;
+}
+
+// The driver's numbers in a checkpoint, by name (one list, so save and restore cannot disagree).
+struct DriverNumbers {
+  RunSummary& sum;
+  bool& have_ref;
+  long long& out_index;
+  long long& k_next;
+  double& E_seen;  // scale of rel_drift while loads act (observe())
+  template <class F>
+  void each(F&& f) {
+    f("E_seen", E_seen);
+    double ref = have_ref ? 1.0 : 0.0, oi = static_cast<double>(out_index), kn = static_cast<double>(k_next);
+    f("have_ref", ref), f("out_index", oi), f("k_next", kn);
+    f("H0", sum.H0), f("H_ref", sum.H_ref), f("E_ref", sum.E_ref), f("t_ref", sum.t_ref), f("H_final", sum.H_final);
+    f("max_rel_drift", sum.max_rel_drift), f("final_rel_drift", sum.final_rel_drift);
+    f("max_dL", sum.max_dL), f("max_dJ", sum.max_dJ), f("ref_L", sum.ref_L), f("ref_J", sum.ref_J);
+    f("max_strain_ratio", sum.max_strain_ratio);
+    StepReport& r = sum.totals;
+    double c[] = {double(r.steps), double(r.rejected_steps), double(r.nonlinear_iterations), double(r.linear_setups),
+                  double(r.factorizations), double(r.rhs_evaluations), double(r.chart_switches), double(r.root_events),
+                  double(r.reinitializations)};
+    const char* names[] = {"steps", "rejected_steps", "nonlinear_iterations", "linear_setups", "factorizations",
+                           "rhs_evaluations", "chart_switches", "root_events", "reinitializations"};
+    for (int i = 0; i < 9; ++i) f(names[i], c[i]);
+    f("residual_norm", r.residual_norm), f("energy_ratio", r.energy_ratio), f("last_dt", r.last_dt);
+    have_ref = ref != 0.0, out_index = static_cast<long long>(oi), k_next = static_cast<long long>(kn);
+    long* counters[] = {&r.steps, &r.rejected_steps, &r.nonlinear_iterations, &r.linear_setups, &r.factorizations,
+                        &r.rhs_evaluations, &r.chart_switches, &r.root_events, &r.reinitializations};
+    for (int i = 0; i < 9; ++i) *counters[i] = static_cast<long>(c[i]);
+  }
+};
+
 }  // namespace
+
+std::string CheckpointPolicy::text() const {
+  if (steps > 0) return std::to_string(steps);
+  if (sim_time > 0.0) return g17(sim_time) + "s";
+  if (wall > 0.0) return g17(wall) + "w";
+  return "off";
+}
+
+CheckpointPolicy parse_checkpoint_policy(const std::string& text) {
+  CheckpointPolicy p;
+  p.requested = true;
+  const std::string how = " (use N steps, e.g. 500; Ts simulated time, e.g. 0.5s; Ww wall seconds, e.g. 60w; or off)";
+  if (text == "off" || text == "0") return p;
+  if (text.empty()) throw std::invalid_argument("--checkpoint-every: empty" + how);
+  const char unit = text.back();
+  const std::string number = (unit == 's' || unit == 'w') ? text.substr(0, text.size() - 1) : text;
+  char* end = nullptr;
+  const double x = std::strtod(number.c_str(), &end);
+  if (number.empty() || *end != '\0' || !std::isfinite(x) || !(x > 0.0) || x > 1e12)
+    throw std::invalid_argument("--checkpoint-every '" + text + "': not a positive value" + how);
+  if (unit == 's')
+    p.sim_time = x;
+  else if (unit == 'w')
+    p.wall = x;
+  else if (x != std::floor(x))
+    throw std::invalid_argument("--checkpoint-every '" + text + "': a step count must be whole" + how);
+  else
+    p.steps = static_cast<long long>(x);
+  return p;
+}
+
+CheckpointPolicy default_checkpoint_policy() {
+  CheckpointPolicy p;
+  p.wall = 60.0;
+  return p;
+}
+
+Problem problem_from_checkpoint(const Checkpoint& c) {
+  CaseSpec spec = load_case_from_string(c.text("case_text"), c.text("case_source"), c.text("case_base_dir"));
+  if (const auto* m = std::get_if<MeshFileSpec>(&spec.mesh)) {
+    const std::filesystem::path mesh = std::filesystem::path(spec.base_dir) / m->path;
+    if (content_hash(read_file(mesh.string())) != c.text("mesh_hash"))
+      throw std::runtime_error(mesh.string() + ": the mesh file changed since the checkpoint; rerun from the start");
+  }
+  // What the caller changed after reading the case (e.g. pinched_hemisphere --density).
+  spec.name = c.text("case_name");
+  spec.description = c.text("case_description");
+  spec.material.E = c.number("material_E");
+  spec.material.nu = c.number("material_nu");
+  spec.material.rho = c.number("material_rho");
+  spec.material.thickness = c.number("material_thickness");
+  spec.material.shear_factor = c.number("material_shear_factor");
+  spec.output.history = c.number("output_history") != 0.0;
+  return make_problem(std::move(spec));
+}
+
+RunOptions run_options_from_checkpoint(const Checkpoint& c) {
+  RunOptions o;
+  o.integrator = c.text("integrator");
+  o.settings = decode_pairs(c.text("settings"));
+  o.overrides = decode_pairs(c.text("overrides"));
+  o.dt = c.number("dt");
+  o.t_end = c.number("t_end");
+  o.output_interval = c.number("output_interval");
+  o.vtu_every = static_cast<int>(c.number("vtu_every"));
+  o.label = c.text("label");
+  o.command = c.text("command");
+  o.checkpoint = parse_checkpoint_policy(c.text("checkpoint_policy"));
+  o.checkpoint.requested = false;
+  // The limits that stopped the run are not carried over: `shelldyn resume` sets new ones if asked.
+  o.max_steps = 0;
+  o.max_wall = 0.0;
+  return o;
+}
 
 RunSummary run_dynamic(Problem& problem, const RunOptions& o) {
   const auto start = Clock::now();
   CaseSpec& spec = problem.spec;
   Model& model = *problem.model;
   if (o.threads > 0) omp_set_num_threads(o.threads);
+  const Checkpoint* resume = o.resume;
+  const std::string case_text = resume ? resume->text("case_text") : read_file(spec.source);
+  const std::string mesh_hash =
+      resume ? resume->text("mesh_hash")
+             : (std::holds_alternative<MeshFileSpec>(spec.mesh)
+                    ? content_hash(read_file((std::filesystem::path(spec.base_dir) / std::get<MeshFileSpec>(spec.mesh).path).string()))
+                    : std::string());
+  const CaseMaterial material = spec.material;
+  const std::string case_name = spec.name, case_description = spec.description;
 
   // --- resolve settings ---------------------------------------------------------------------------
   const double dt = o.dt > 0.0 ? o.dt : spec.time.dt;
   const double t_end = o.t_end >= 0.0 ? o.t_end : spec.time.t_end;
   double out_dt = o.output_interval > 0.0 ? o.output_interval : spec.time.output_interval;
-  if (!(dt > 0.0) || !std::isfinite(dt)) throw std::invalid_argument("time step dt must be > 0 (got " + std::to_string(dt) + ")");
-  if (!(t_end >= 0.0) || !std::isfinite(t_end)) throw std::invalid_argument("t_end must be >= 0 (got " + std::to_string(t_end) + ")");
+  if (!(dt > 0.0) || !std::isfinite(dt)) throw std::invalid_argument("time step dt must be > 0 (got " + g17(dt) + ")");
+  if (!(t_end >= 0.0) || !std::isfinite(t_end)) throw std::invalid_argument("t_end must be >= 0 (got " + g17(t_end) + ")");
   if (out_dt < dt) out_dt = dt;
+  if (t_end / dt > 1e10 || t_end / out_dt > 1e9)
+    throw std::invalid_argument("t_end = " + g17(t_end) + " needs more than 1e10 steps of dt = " + g17(dt) +
+                                " (or 1e9 outputs); check t_end, dt and the output interval");
+  if (o.max_steps < 0) throw std::invalid_argument("max_steps must be >= 0");
+  if (!(o.max_wall >= 0.0) || !std::isfinite(o.max_wall)) throw std::invalid_argument("max_wall must be >= 0");
   const int vtu_every = o.vtu_every >= 0 ? o.vtu_every : (spec.output.vtu ? spec.output.vtu_every : 0);
-  // Another integrator than the case's keeps the case settings it understands (as `shelldyn compare` does).
-  IntegratorSettings settings = o.integrator.empty() || o.integrator == spec.integrator.name
-                                    ? IntegratorSettings(spec.integrator)
-                                    : IntegratorSettings(o.integrator, o.integrator == "static"
-                                                                           ? std::vector<std::pair<std::string, std::string>>{}
-                                                                           : settings_understood_by(o.integrator, spec.integrator.settings));
-  for (const auto& [k, v] : o.settings) settings.set(k, v);
-  if (settings.name() == "static")
-    throw std::invalid_argument("integrator 'static' is the static solver: use `shelldyn static CASE`");
-  std::unique_ptr<Integrator> integrator = make_integrator(settings, dt);
+  std::unique_ptr<Integrator> integrator = make_case_integrator(spec, o.integrator, o.settings, dt);
 
   RunSummary sum;
   sum.integrator = integrator->name();
@@ -85,13 +264,16 @@ RunSummary run_dynamic(Problem& problem, const RunOptions& o) {
   spec.time.dt = dt;
   spec.time.t_end = t_end;
   spec.time.output_interval = out_dt;
+  spec.output.vtu = vtu_every > 0;
+  spec.output.vtu_every = vtu_every > 0 ? vtu_every : spec.output.vtu_every;
 
   // --- outputs --------------------------------------------------------------------------------------
   const auto& monitors = problem.disc.monitors;
   RunInfo info;
   info.command = o.command;
   info.sundials_version = sundials_version();
-  info.status = "incomplete: running";
+  info.status = "incomplete: running";  // what a killed run leaves (with its last checkpoint)
+  for (const auto& [k, v] : o.overrides) info.overrides.set(k, v);
   info.discretization.set("nodes", model.mesh().num_nodes());
   info.discretization.set("elements", model.mesh().num_elements());
   info.discretization.set("dofs", static_cast<long long>(model.num_dofs()));
@@ -101,14 +283,19 @@ RunSummary run_dynamic(Problem& problem, const RunOptions& o) {
   std::unique_ptr<HistoryWriter> history;
   std::unique_ptr<PvdWriter> pvd;
   const bool files = !o.out_dir.empty();
+  const std::string run_json_path = o.out_dir + "/run.json";
+  const std::string checkpoint_path = o.out_dir + "/" + checkpoint_file_name();
   if (files) {
     prepare_output_folder(o.out_dir);
-    write_run_json(o.out_dir + "/run.json", spec, info);
+    write_run_json(run_json_path, spec, info);
     std::vector<std::string> names;
     for (const auto& m : monitors) names.push_back(m.name);
     // damping_work: energy dissipated by Rayleigh damping (docs/theory.md §8.5), only for damped models.
     const std::vector<std::string> extra = model.has_damping() ? std::vector<std::string>{"damping_work"} : std::vector<std::string>{};
-    if (spec.output.history) history = std::make_unique<HistoryWriter>(o.out_dir + "/history.csv", extra, names);
+    if (spec.output.history)
+      history = resume ? std::make_unique<HistoryWriter>(o.out_dir + "/history.csv", extra, names,
+                                                         static_cast<long long>(resume->number("history_bytes")))
+                       : std::make_unique<HistoryWriter>(o.out_dir + "/history.csv", extra, names);
     if (vtu_every > 0) pvd = std::make_unique<PvdWriter>(o.out_dir + "/fields.pvd");
   }
 
@@ -119,13 +306,105 @@ RunSummary run_dynamic(Problem& problem, const RunOptions& o) {
   bool have_ref = false;
   Eigen::Vector3d L_ref = Eigen::Vector3d::Zero(), J_ref = Eigen::Vector3d::Zero();
   double last_print = -1.0;
-  long long out_index = 0;
+  long long out_index = 0, k_next = 1;
   // Progress (docs/manual.md §1): one line updated in place on a terminal (every 0.2 s of wall time);
   // otherwise a plain line at every 10 % of the simulated time.
   const bool tty = o.log && ((o.log == &std::cout && isatty(STDOUT_FILENO)) || (o.log == &std::cerr && isatty(STDERR_FILENO)));
   bool line_open = false;
   double next_plain_t = 0.0;
   double E_seen = 0.0;  // largest K + V or |W_ext| so far: the scale of the energy balance while loads act
+  double wall_before = 0.0;  // wall time of the run before its last resume
+  const long long n_out = static_cast<long long>(std::ceil(t_end / out_dt - 1e-9));
+  if (resume) {
+    if (resume->integrator != integrator->name())
+      throw std::runtime_error("checkpoint of integrator '" + resume->integrator + "', run of '" + integrator->name() + "'");
+    state = resume->state;
+    if (state.u.size() != model.num_dofs() || static_cast<int>(state.charts.size()) != model.mesh().num_nodes())
+      throw std::runtime_error("the checkpoint does not fit this case's model (" + std::to_string(state.u.size()) + " DOFs)");
+    model.adopt_charts(state.charts);
+    integrator->restore(model, state, resume->integrator_data);
+    DriverNumbers{sum, have_ref, out_index, k_next, E_seen}.each([&](const char* key, double& x) { x = resume->number(key); });
+    L_ref = resume->vector("L_ref");
+    J_ref = resume->vector("J_ref");
+    wall_before = resume->number("wall_s");
+    if (pvd) {
+      const Eigen::VectorXd& times = resume->vector("pvd_times");
+      std::istringstream files_in(resume->text("pvd_files"));
+      std::vector<std::pair<double, std::string>> entries;
+      std::string f;
+      for (Eigen::Index i = 0; i < times.size() && std::getline(files_in, f); ++i) entries.emplace_back(times[i], f);
+      pvd->restore(std::move(entries));
+    }
+  }
+  auto elapsed = [&] { return wall_before + std::chrono::duration<double>(Clock::now() - start).count(); };
+
+  // Checkpoints: is the integrator able to? (An explicit request must not be silently dropped.)
+  const CheckpointPolicy policy = files ? o.checkpoint : CheckpointPolicy{};
+  bool can_checkpoint = files;
+  if (files) {
+    try {
+      IntegratorCheckpoint probe;
+      integrator->save(probe);
+    } catch (const std::exception& e) {
+      if (policy.requested && policy.enabled()) throw std::invalid_argument(std::string(e.what()));
+      can_checkpoint = false;
+      if (o.log && policy.enabled()) *o.log << "note: " << e.what() << "; this run writes no checkpoints" << std::endl;
+    }
+  }
+
+  auto write_ckpt = [&](long long next_k) {
+    Checkpoint c;
+    c.state = state;
+    c.integrator = integrator->name();
+    integrator->save(c.integrator_data);
+    long long oi = out_index, kn = next_k;
+    bool hr = have_ref;
+    double es = E_seen;
+    DriverNumbers{sum, hr, oi, kn, es}.each([&](const char* key, double& x) { c.numbers[key] = x; });
+    c.vectors["L_ref"] = L_ref;
+    c.vectors["J_ref"] = J_ref;
+    c.numbers["wall_s"] = elapsed();
+    c.numbers["history_bytes"] = history ? static_cast<double>(history->bytes()) : 0.0;
+    std::string pvd_files;
+    Eigen::VectorXd pvd_times(pvd ? static_cast<Eigen::Index>(pvd->entries().size()) : 0);
+    if (pvd)
+      for (size_t i = 0; i < pvd->entries().size(); ++i) {
+        pvd_times[static_cast<Eigen::Index>(i)] = pvd->entries()[i].first;
+        pvd_files += pvd->entries()[i].second + "\n";
+      }
+    c.vectors["pvd_times"] = pvd_times;
+    c.texts["pvd_files"] = pvd_files;
+    // How to rebuild the run (shelldyn resume): case text, what the caller changed, the options.
+    c.texts["case_text"] = case_text;
+    c.texts["case_source"] = spec.source;
+    c.texts["case_base_dir"] = spec.base_dir;
+    c.texts["mesh_hash"] = mesh_hash;
+    c.texts["case_name"] = case_name;
+    c.texts["case_description"] = case_description;
+    c.numbers["material_E"] = material.E;
+    c.numbers["material_nu"] = material.nu;
+    c.numbers["material_rho"] = material.rho;
+    c.numbers["material_thickness"] = material.thickness;
+    c.numbers["material_shear_factor"] = material.shear_factor;
+    c.numbers["output_history"] = spec.output.history ? 1.0 : 0.0;
+    c.texts["integrator"] = o.integrator;
+    c.texts["settings"] = encode_pairs(o.settings);
+    c.texts["overrides"] = encode_pairs(o.overrides);
+    c.numbers["dt"] = o.dt;
+    c.numbers["t_end"] = o.t_end;
+    c.numbers["output_interval"] = o.output_interval;
+    c.numbers["vtu_every"] = o.vtu_every;
+    c.texts["label"] = o.label;
+    c.texts["command"] = o.command;
+    c.texts["checkpoint_policy"] = policy.text();
+    c.numbers["max_steps"] = static_cast<double>(o.max_steps);
+    c.numbers["max_wall"] = o.max_wall;
+    write_checkpoint(checkpoint_path, c);
+    info.checkpoint.set("file", checkpoint_file_name());
+    info.checkpoint.set("t", state.t);
+    info.checkpoint.set("step", sum.totals.steps);
+    info.checkpoint.set("exact", c.integrator_data.exact);
+  };
 
   auto observe = [&](const StepReport& rep, bool last) {
     const Invariants inv = model.invariants(state);
@@ -158,7 +437,7 @@ RunSummary run_dynamic(Problem& problem, const RunOptions& o) {
     if (inv.kinetic + inv.strain > 0.0)
       sum.max_strain_ratio = std::max(sum.max_strain_ratio, inv.strain / (inv.kinetic + inv.strain));
     sum.H_final = H;
-    const double wall = std::chrono::duration<double>(Clock::now() - start).count();
+    const double wall = elapsed();
     std::vector<double> mon;
     const bool vtu_now = pvd && out_index % vtu_every == 0;
     Eigen::VectorXd R;  // reaction forces (docs/theory.md §9.2), for monitors rx..rz and the VTU
@@ -212,33 +491,100 @@ RunSummary run_dynamic(Problem& problem, const RunOptions& o) {
     ++out_index;
   };
 
-  try {
-    observe(StepReport{}, t_end <= 0.0);
-    const long long n_out = static_cast<long long>(std::ceil(t_end / out_dt - 1e-9));
-    for (long long k = 1; k <= n_out; ++k) {
-      const double t_out = std::min(t_end, static_cast<double>(k) * out_dt);
-      const StepReport rep = integrator->advance(model, state, t_out);
-      sum.totals.accumulate(rep);
-      observe(rep, k == n_out);
+  // Writes run.json; if that fails too (full disk), the caller's cause stays the error reported.
+  auto write_status = [&](const std::string& status) -> std::string {
+    sum.status = status;
+    sum.wall_seconds = elapsed();
+    if (!files) return {};
+    info.status = status;
+    fill_summary_json(info.summary, sum);
+    try {
+      write_run_json(run_json_path, spec, info);
+    } catch (const std::exception& e) {
+      return e.what();
     }
+    return {};
+  };
+
+  SignalGuard signals(o.handle_signals);
+  integrator->set_stop_request([&] { return g_stop_signal != 0 || (o.max_wall > 0.0 && elapsed() >= o.max_wall); });
+  std::string stop_reason;  // non-empty: orderly stop
+  int stop_code = 0;
+  double next_ckpt_time = policy.sim_time > 0.0 ? (std::floor(state.t / policy.sim_time) + 1.0) * policy.sim_time : 0.0;
+  long long next_ckpt_step = policy.steps > 0 ? (sum.totals.steps / policy.steps + 1) * policy.steps : 0;
+  double next_ckpt_wall = policy.wall > 0.0 ? elapsed() + policy.wall : 0.0;
+  auto stop_requested = [&](long long next_k) {
+    if (g_stop_signal != 0) {
+      stop_code = 128 + g_stop_signal;
+      stop_reason = std::string("interrupted: ") + (g_stop_signal == SIGINT ? "SIGINT" : "SIGTERM");
+    } else if (o.max_wall > 0.0 && elapsed() >= o.max_wall) {
+      stop_code = 4;
+      stop_reason = "stopped: --max-wall " + g17(o.max_wall) + " s reached";
+    } else if (o.max_steps > 0 && sum.totals.steps >= o.max_steps && next_k <= n_out) {
+      stop_code = 4;
+      stop_reason = "stopped: --max-steps " + std::to_string(o.max_steps) + " reached";
+    }
+    return stop_code != 0;
+  };
+
+  try {
+    if (!resume) observe(StepReport{}, t_end <= 0.0);
+    for (long long k = k_next; k <= n_out; ++k) {
+      const double t_out = std::min(t_end, static_cast<double>(k) * out_dt);
+      StepReport rep;
+      bool abandoned = false;
+      try {
+        rep = integrator->advance(model, state, t_out);
+      } catch (const RunInterrupted&) {
+        abandoned = true;  // state is still the last output state
+      }
+      sum.totals.accumulate(rep);
+      const bool reached = !abandoned && state.t >= t_out - 1e-9 * dt;
+      if (reached) observe(rep, k == n_out);
+      const long long next_k = reached ? k + 1 : k;
+      if (!reached || (k < n_out && stop_requested(next_k))) {
+        if (!reached && !stop_requested(next_k)) throw std::logic_error(sum.integrator + " stopped before t_out without a request");
+        std::string where = " at t = " + g17(state.t) + " of " + g17(t_end) + " (step " + std::to_string(sum.totals.steps) + ")";
+        std::string resume_hint;
+        if (can_checkpoint) {
+          write_ckpt(next_k);
+          resume_hint = "; continue with: shelldyn resume " + o.out_dir;
+        } else {
+          resume_hint = files ? "; no checkpoint (not supported by this integrator)" : "";
+        }
+        if (line_open) *o.log << std::endl;  // end the in-place status line before the message
+        line_open = false;
+        const std::string msg = stop_reason + where + resume_hint;
+        const std::string json_error = write_status(msg);
+        throw RunStopped(msg + (json_error.empty() ? "" : "; " + json_error), stop_code);
+      }
+      if (k == n_out) break;
+      const bool due = (policy.steps > 0 && sum.totals.steps >= next_ckpt_step) ||
+                       (policy.sim_time > 0.0 && state.t >= next_ckpt_time - 1e-9 * dt) ||
+                       (policy.wall > 0.0 && elapsed() >= next_ckpt_wall);
+      if (due && can_checkpoint) {
+        write_ckpt(next_k);
+        write_status(info.status);  // run.json names the checkpoint
+        if (policy.steps > 0) next_ckpt_step = (sum.totals.steps / policy.steps + 1) * policy.steps;
+        if (policy.sim_time > 0.0) next_ckpt_time = (std::floor(state.t / policy.sim_time + 1e-9) + 1.0) * policy.sim_time;
+        if (policy.wall > 0.0) next_ckpt_wall = elapsed() + policy.wall;
+      }
+    }
+  } catch (const RunStopped&) {
+    throw;
   } catch (const std::exception& e) {
     if (line_open) *o.log << std::endl;  // end the in-place status line before the error message
-    sum.status = std::string("incomplete: ") + e.what();
-    sum.wall_seconds = std::chrono::duration<double>(Clock::now() - start).count();
-    if (files) {
-      info.status = sum.status;
-      fill_summary_json(info.summary, sum);
-      write_run_json(o.out_dir + "/run.json", spec, info);
-    }
+    const std::string json_error = write_status(std::string("incomplete: ") + e.what());
+    if (!json_error.empty()) throw std::runtime_error(std::string(e.what()) + "; " + json_error);
     throw;
   }
-  sum.status = "complete";
-  sum.wall_seconds = std::chrono::duration<double>(Clock::now() - start).count();
   if (files) {
-    info.status = sum.status;
-    fill_summary_json(info.summary, sum);
-    write_run_json(o.out_dir + "/run.json", spec, info);
+    std::error_code ec;
+    std::filesystem::remove(checkpoint_path, ec);  // the run is complete: nothing to resume
+    info.checkpoint = JsonFields{};
   }
+  const std::string json_error = write_status("complete");
+  if (!json_error.empty()) throw std::runtime_error(json_error);
   return sum;
 }
 

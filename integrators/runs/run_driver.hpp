@@ -16,11 +16,30 @@
 // measured from the same reference time.
 //
 // Failure (StepFailure, bad settings, I/O): run.json gets status "incomplete: <reason>", the history and
-// fields written so far stay, and the exception propagates (the CLI exits non-zero).
+// fields written so far stay, and the exception propagates (the CLI exits non-zero). If run.json itself
+// cannot be written (e.g. the disk is full), the original cause is still what propagates.
+//
+// Checkpoints, limits and signals (docs/architecture.md "Checkpoints and resume"):
+//   - RunOptions::checkpoint says when DIR/checkpoint.cbor is (re)written (integrators/checkpoint/):
+//     every N steps, every T of simulated time or every W seconds of wall time, at the first output time
+//     after the threshold; written atomically; removed when the run completes.
+//   - handle_signals: the first SIGINT/SIGTERM asks the integrator to stop after the current step
+//     (Newmark family) or abandons the current output interval (SUNDIALS: back to the last output
+//     time); the driver writes a checkpoint and run.json "interrupted: ..." and throws RunStopped with
+//     exit code 130 / 143. A second signal exits at once (_exit(128 + signal)).
+//   - max_wall (checked like a signal) and max_steps (checked at output times) stop the run the same
+//     way with status "stopped: ..." and exit code 4.
+//   - resume: continue from a checkpoint (shelldyn resume DIR): history.csv is cut at the checkpoint's
+//     row and continued, fields.pvd keeps its entries, counters and reference quantities continue. For
+//     the Newmark family the continued run is bitwise the uninterrupted one (history.csv identical but
+//     for the wall_s column); SUNDIALS baselines restart from the saved state (see their save()).
 #pragma once
 
+#include "integrators/checkpoint/checkpoint.hpp"
 #include "integrators/integrator.hpp"
 #include "lib/problem.hpp"
+
+#include <stdexcept>
 
 #include <ostream>
 #include <string>
@@ -28,6 +47,32 @@
 #include <vector>
 
 namespace shelldyn {
+
+// When to write checkpoints. At most one of the thresholds is normally set; 0 = not by this measure.
+struct CheckpointPolicy {
+  long long steps = 0;     // every this many steps
+  double sim_time = 0.0;   // every this much simulated time
+  double wall = 0.0;       // every this many seconds of wall time
+  bool requested = false;  // given explicitly: an integrator without checkpoints is then an error
+  bool enabled() const { return steps > 0 || sim_time > 0.0 || wall > 0.0; }
+  std::string text() const;  // e.g. "500", "0.5s", "60w", "off"
+};
+// Parses --checkpoint-every: "N" (steps), "Ts" (simulated time), "Ww" (wall seconds), "off" or "0".
+// Throws std::invalid_argument with an example on anything else (nan, negative, huge, junk).
+CheckpointPolicy parse_checkpoint_policy(const std::string& text);
+// Default of `shelldyn run` and the apps: every 60 s of wall time (short runs never write one).
+CheckpointPolicy default_checkpoint_policy();
+
+// Thrown after an orderly stop (signal, --max-wall, --max-steps): everything is written, run.json says
+// "interrupted: ..." or "stopped: ...", a checkpoint exists if the integrator supports them.
+class RunStopped : public std::runtime_error {
+ public:
+  RunStopped(const std::string& what, int exit_code) : std::runtime_error(what), exit_code_(exit_code) {}
+  int exit_code() const { return exit_code_; }
+
+ private:
+  int exit_code_;
+};
 
 struct RunOptions {
   std::string out_dir;             // empty: no files at all
@@ -41,7 +86,22 @@ struct RunOptions {
   std::ostream* log = nullptr;     // progress lines and the final summary
   std::string command;             // recorded in run.json
   std::string label;               // optional label printed in progress lines (e.g. "FLP-prov")
+  CheckpointPolicy checkpoint;     // default: none (the CLI and the apps use default_checkpoint_policy())
+  long long max_steps = 0;         // stop at the first output time with at least this many steps; 0: none
+  double max_wall = 0.0;           // stop after this many seconds of wall time; 0: none
+  bool handle_signals = false;     // SIGINT/SIGTERM stop the run in order (see above)
+  const Checkpoint* resume = nullptr;  // continue from this checkpoint (the folder is out_dir)
+  // Command-line flags that changed the case (recorded in run.json "command_line_overrides").
+  std::vector<std::pair<std::string, std::string>> overrides;
 };
+
+// Name of the checkpoint file in a result folder.
+inline const char* checkpoint_file_name() { return "checkpoint.cbor"; }
+
+// `shelldyn resume`: the Problem and RunOptions stored in a checkpoint (case text, resolved material,
+// command-line options). Throws std::runtime_error if a mesh file changed since the checkpoint.
+Problem problem_from_checkpoint(const Checkpoint& c);
+RunOptions run_options_from_checkpoint(const Checkpoint& c);
 
 struct RunSummary {
   std::string integrator;

@@ -7,38 +7,64 @@
 #include "lib/state_output.hpp"
 
 #include <cstdio>
+#include <limits>
 #include <fstream>
 #include <memory>
 #include <stdexcept>
 
 namespace shelldyn {
 
-StaticOptions static_options(const CaseSpec& spec) {
+StaticOptions static_options(const CaseSpec& spec, const Discretization* disc) {
   IntegratorSettings s(spec.integrator);
   if (s.name() != "static")
     throw std::invalid_argument("integrator.name: '" + s.name() + "' is not the static solver (use name: static)");
   StaticOptions o;
+  o.control = parse_path_control(s.get("control", std::string("load")));
   o.increment = s.get("increment", spec.time.dt);
-  o.min_increment = s.get("min_increment", o.increment * 1e-4);
+  o.min_increment = s.get("min_increment", o.control == PathControl::load ? o.increment * 1e-4 : 1e-4);
   o.growth = s.get("growth", 1.5);
   o.easy_iterations = s.get("easy_iterations", 6);
+  o.target_iterations = s.get("target_iterations", 5);
+  o.max_arc_factor = s.get("max_arc_factor", 4.0);
+  o.max_steps = s.get("max_steps", 1000);
   o.rechart_hysteresis = s.get("hysteresis", 1.0);
-  o.newton.max_iters = s.get("max_iters", 30);
-  o.newton.fnorm_tol = s.get("tol", 1e-9);
-  o.newton.linear_solver = s.get("linear_solver", "eigen-ldlt");
-  o.newton.line_search = s.get("line_search", false);
+  o.max_iters = s.get("max_iters", 30);
+  o.jump_ratio = s.get("jump_ratio", 5.0);
+  o.convergence.residual_tol = s.get("tol", 1e-8);
+  o.convergence.increment_tol = s.get("step_tol", 1e-10);
+  o.linear_solver = s.get("linear_solver", std::string("eigen-ldlt"));
+  const std::string control_set = s.get("control_set", std::string());
+  const std::string control_dir = s.get("control_dof", std::string("uz"));
+  o.displacement_end = s.get("displacement_end", std::numeric_limits<double>::quiet_NaN());
   s.finish();
+  if (o.control == PathControl::displacement) {
+    if (control_set.empty())
+      throw std::invalid_argument("integrator: control: displacement needs control_set (a one-node set) and control_dof (ux|uy|uz)");
+    int comp = control_dir == "ux" ? 0 : control_dir == "uy" ? 1 : control_dir == "uz" ? 2 : -1;
+    if (comp < 0) throw std::invalid_argument("integrator.control_dof: '" + control_dir + "' is not ux, uy or uz");
+    if (disc) {
+      const auto it = disc->mesh.node_sets.find(control_set);
+      if (it == disc->mesh.node_sets.end() || it->second.size() != 1)
+        throw std::invalid_argument("integrator.control_set: '" + control_set + "' must name a node set with exactly one node");
+      o.control_dof = DofMap::dof(it->second.front(), comp);
+    }
+  }
+  // λ is a load factor only when every load grows proportionally to it (ramps); otherwise it is a
+  // pseudo-time and the messages say so.
+  bool proportional = true;
+  for (const auto& l : spec.loads) proportional = proportional && l.function.kind() == TimeFunction::Kind::Ramp;
+  o.parameter_name = proportional ? "load factor" : "pseudo-time t";
   return o;
 }
 
 std::vector<StaticRow> run_static(Problem& problem, const std::string& out_dir, std::ostream* log,
                                   StaticReport* report_out) {
   const CaseSpec& spec = problem.spec;
-  const StaticOptions options = static_options(spec);
+  const StaticOptions options = static_options(spec, &problem.disc);
   Model& model = *problem.model;
   // Follower loads have a non-symmetric tangent: in full with the LU solver (quadratic Newton), else its
   // symmetric part (docs/theory.md §8.2).
-  model.set_unsymmetric_load_stiffness(options.newton.linear_solver == "klu");
+  model.set_unsymmetric_load_stiffness(options.linear_solver == "klu");
   const auto& monitors = problem.disc.monitors;
 
   std::unique_ptr<std::ofstream> csv;
@@ -56,12 +82,12 @@ std::vector<StaticRow> run_static(Problem& problem, const std::string& out_dir, 
     csv = std::make_unique<std::ofstream>(out_dir + "/static.csv");
     *csv << "step,load_factor";
     for (const auto& m : monitors) *csv << ',' << m.name;
-    *csv << ",newton_iters\n";
+    *csv << ",newton_iters,arc_length,negative_pivots,event\n";
     pvd = std::make_unique<PvdWriter>(out_dir + "/fields.pvd");
   }
 
   std::vector<StaticRow> rows;
-  auto record = [&](const State& s, int step, int iters) {
+  auto record = [&](const State& s, int step, int iters, double arc, long pivots, const std::string& event) {
     StaticRow row;
     row.step = step;
     row.load_factor = s.t;
@@ -80,36 +106,46 @@ std::vector<StaticRow> run_static(Problem& problem, const std::string& out_dir, 
         std::snprintf(buf, sizeof buf, ",%.17g", x);
         *csv << buf;
       }
-      *csv << ',' << iters << '\n' << std::flush;
+      std::snprintf(buf, sizeof buf, ",%d,%.17g,%ld,", iters, arc, pivots);
+      *csv << buf << (event.empty() ? "-" : event) << '\n' << std::flush;
     }
     if (write_vtu_now) {
       const std::string file = "fields/" + vtu_step_file_name(step);  // like run (docs/manual.md §4)
       write_vtu(out_dir + "/" + file, model.mesh(), state_fields(model, s, &R));
       pvd->add(s.t, file);
     }
+    row.arc_length = arc;
+    row.negative_pivots = pivots;
+    row.event = event;
     rows.push_back(std::move(row));
   };
 
   State state = model.initial_state();
-  record(state, 0, 0);
-  StaticSolver solver(model, options);
   StaticReport report;
-  try {
+  try {  // bad settings and I/O errors too must end in "incomplete: <reason>", not "running"
+    record(state, 0, 0, 0.0, 0, "");
+    StaticSolver solver(model, options);
     report = solver.solve(state, spec.time.t_end, [&](const State& s, const StaticIncrement& inc) {
-      record(s, inc.step, inc.newton_iterations);
+      record(s, inc.step, inc.newton_iterations, inc.arc_length, inc.negative_pivots, inc.event);
       if (log) {
         char buf[256];
-        std::snprintf(buf, sizeof buf, "increment %4d  load factor %.6f  Newton %2d  cuts %d  chart switches %d",
-                      inc.step, inc.load_factor, inc.newton_iterations, inc.cuts, inc.chart_switches);
+        std::snprintf(buf, sizeof buf, "%s %4d  %s %.6f  Newton %2d  cuts %d  chart switches %d  neg. pivots %ld",
+                      options.control == PathControl::load ? "increment" : "step", inc.step, options.parameter_name.c_str(),
+                      inc.load_factor, inc.newton_iterations, inc.cuts, inc.chart_switches, inc.negative_pivots);
         *log << buf;
         for (size_t k = 0; k < monitors.size(); ++k) *log << "  " << monitors[k].name << " " << rows.back().monitors[k];
+        if (!inc.event.empty()) *log << "  ** " << inc.event;
         *log << std::endl;
       }
     });
   } catch (const std::exception& e) {
     if (!out_dir.empty()) {
       info.status = std::string("incomplete: ") + e.what();
-      write_run_json(out_dir + "/run.json", spec, info);
+      try {
+        write_run_json(out_dir + "/run.json", spec, info);
+      } catch (const std::exception& j) {  // e.g. the disk is full: report the cause, then this
+        throw std::runtime_error(std::string(e.what()) + "; " + j.what());
+      }
     }
     throw;
   }
@@ -121,6 +157,20 @@ std::vector<StaticRow> run_static(Problem& problem, const std::string& out_dir, 
   info.summary.set("chart_switches", report.chart_switches);
   info.summary.set("wall_s", report.wall_seconds);
   info.summary.set("final_load_factor", state.t);
+  info.summary.set("control", path_control_name(options.control));
+  info.summary.set("max_load_factor", report.max_load_factor);
+  info.summary.set("critical_points", static_cast<int>(report.critical_points.size()));
+  for (size_t k = 0; k < report.critical_points.size(); ++k) {
+    const auto& cp = report.critical_points[k];
+    const std::string key = "critical_point_" + std::to_string(k + 1);
+    info.summary.set(key + "_kind", cp.kind);
+    info.summary.set(key + "_step", cp.step);
+    info.summary.set(key + "_load_factor", cp.load_factor);
+    info.summary.set(key + "_estimate", cp.estimate);
+    info.summary.set(key + "_note", cp.note);
+  }
+  if (log)
+    for (const auto& cp : report.critical_points) *log << "critical point at step " << cp.step << ": " << cp.note << std::endl;
   if (!out_dir.empty()) write_run_json(out_dir + "/run.json", spec, info);
   if (report_out) *report_out = report;
   return rows;

@@ -1,5 +1,7 @@
-// Runs a static case end to end: options from the case's integrator block, load stepping, outputs
-// (static.csv, fields/ VTU series + fields.pvd, run.json) and a one-line progress report per increment.
+// Runs a static case end to end: options from the case's integrator block, load stepping or path
+// following, outputs (static.csv: step, load_factor, monitors, newton_iters, arc_length,
+// negative_pivots, event ("-" or the critical point passed); fields/ VTU series + fields.pvd; run.json
+// with the critical points in its summary) and a one-line progress report per reported point.
 #pragma once
 
 #include "integrators/nonlinear/static_solver.hpp"
@@ -11,16 +13,22 @@
 
 namespace shelldyn {
 
-// Reads the `integrator: {name: static, ...}` settings: increment (default time.dt), min_increment,
-// growth, easy_iterations, max_iters, tol (relative residual, default 1e-9), linear_solver,
-// line_search, hysteresis.
-StaticOptions static_options(const CaseSpec& spec);
+// Reads the `integrator: {name: static, ...}` settings (docs/statics.md): control (load | arc_length |
+// displacement), increment (default time.dt), min_increment, growth, easy_iterations, target_iterations,
+// max_arc_factor, max_steps, max_iters, tol (residual relative to F_ref, default 1e-8), step_tol (increment
+// relative to the displacement scale, default 1e-10), linear_solver, hysteresis, and for displacement
+// control control_set (one node), control_dof (ux|uy|uz), displacement_end. `disc` resolves control_set
+// (may be null when control is not displacement).
+StaticOptions static_options(const CaseSpec& spec, const Discretization* disc = nullptr);
 
 struct StaticRow {
   int step = 0;
   double load_factor = 0.0;
   std::vector<double> monitors;  // in the order of problem.disc.monitors
   int newton_iterations = 0;
+  double arc_length = 0.0;       // cumulative ‖Δd‖₂ of the translations along the path
+  long negative_pivots = 0;      // inertia of the converged tangent
+  std::string event;             // "", "limit point", "bifurcation point", "critical point", "snap-through"
 };
 
 // out_dir empty: no files. log may be null. Returns the converged increments (the initial state is

@@ -20,7 +20,7 @@ def fail(msg):
 
 def main():
     exe, case, t_end, out = sys.argv[1:5]
-    r = subprocess.run([exe, "run", case, "--t-end", t_end, "--vtu-every", "0", "-o", out], capture_output=True,
+    r = subprocess.run([exe, "run", case, "--t-end", t_end, "--vtu-every", "0", "--overwrite", "-o", out], capture_output=True,
                        text=True, timeout=300)
     if r.returncode != 0:
         fail("run failed: " + r.stdout + r.stderr)
@@ -30,7 +30,7 @@ def main():
     for l in progress:
         if "nan" in l or "-0.000000" in l or not ("balance" in l or "drift" in l) or "\r" in l:
             fail("bad progress line: " + repr(l))
-    r = subprocess.run([exe, "run", case, "--t-end", t_end, "--vtu-every", "0", "-q", "--plots", "-o", out],
+    r = subprocess.run([exe, "run", case, "--t-end", t_end, "--vtu-every", "0", "-q", "--plots", "--overwrite", "-o", out],
                        capture_output=True, text=True, timeout=300)
     lines = [l for l in r.stdout.splitlines() if l.strip()]
     if r.returncode != 0 or len(lines) != 2 or "complete" not in lines[1]:

@@ -12,12 +12,13 @@ def main():
     sep = sys.argv.index("--")
     code, fragment, cmd = int(sys.argv[1]), sys.argv[2], sys.argv[sep + 1:]
     r = subprocess.run(cmd, capture_output=True, text=True, timeout=60)
-    lines = r.stderr.splitlines()
+    # ONE error line; details (lists of valid names) may follow on lines indented by two spaces.
+    lines = [l for l in r.stderr.splitlines() if not l.startswith("  ")]
     problems = []
     if r.returncode != code:
         problems.append(f"exit code {r.returncode}, expected {code}")
     if len(lines) != 1:
-        problems.append(f"{len(lines)} lines on stderr, expected 1")
+        problems.append(f"{len(lines)} unindented lines on stderr, expected 1")
     elif not lines[0].startswith("shelldyn: error: "):
         problems.append("stderr does not start with 'shelldyn: error: '")
     if fragment not in r.stderr:

@@ -197,7 +197,7 @@ time: {dt: 1, t_end: 1}
   }
   const double err = (Kd - Kfd).norm() / Kd.norm();
   std::printf("assembled tangent with follower pressure vs FD: relative error %.2e\n", err);
-  EXPECT_LT(err, 1e-7);
+  EXPECT_LT(err, 1e-8);  // measured 1.4e-10; 1.4e-7 with the skew part of the load tangent left out
 }
 
 TEST(LoadsValidation, FollowerPressureNewtonConvergesQuadratically) {

@@ -144,7 +144,7 @@ const BadSetup kBad[] = {
     {"unknown set in a load", "loads:\n  - {set: tip, type: force, direction: [0, 0, 1], amplitude: 1}\n",
      "plate.yaml:7: loads[0].set:", "unknown set 'tip'"},
     {"unknown set in a boundary condition", "boundary_conditions:\n  - {set: lft, fix: [ux]}\n",
-     "plate.yaml:7: boundary_conditions[0].set:", "unknown set 'lft' (available: all, bottom"},
+     "plate.yaml:7: boundary_conditions[0].set:", "unknown set 'lft' (define it under 'sets:' or use one below)\navailable: all, bottom"},
     {"unknown set in a monitor", "monitors:\n  - {name: w, set: B, quantity: uz}\n", "plate.yaml:7: monitors[0].set:",
      "unknown set 'B'"},
     {"unknown set in a union", "sets:\n  U: {union: [left, nowhere]}\n", "plate.yaml:7: sets.U.union:",

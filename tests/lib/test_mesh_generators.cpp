@@ -321,3 +321,44 @@ TEST(MakeHemisphere, RejectsBadParameters) {
 
 }  // namespace
 }  // namespace shelldyn
+
+namespace shelldyn {
+namespace {
+
+// Generators for path-following benchmarks (issue 12): geometry, orientation and sets.
+TEST(MeshGenerators, CylinderPatchSitsAtItsNaturalHeightWithEdgesOnCoordinatePlanes) {
+  const Mesh m = make_cylinder_patch(2540.0, 0.1, 254.0, 4, 3);
+  EXPECT_EQ(m.num_nodes(), 9 * 7);
+  EXPECT_EQ(m.num_elements(), 12);
+  for (const Vec3& x : m.X) EXPECT_NEAR(std::hypot(x.y(), x.z()), 2540.0, 1e-9);
+  for (int i : m.node_sets.at("arc0")) EXPECT_EQ(m.X[static_cast<size_t>(i)].y(), 0.0);  // plane Y = 0
+  for (int i : m.node_sets.at("x0")) EXPECT_EQ(m.X[static_cast<size_t>(i)].x(), 0.0);    // plane X = 0
+  EXPECT_DOUBLE_EQ(m.X[static_cast<size_t>(m.node_sets.at("corner_x0_arc0")[0])].z(), 2540.0);
+  EXPECT_THROW(make_cylinder_patch(1.0, 4.0, 1.0, 4, 4), std::invalid_argument);
+}
+
+TEST(MeshGenerators, ClosedCylinderMergesTheSeam) {
+  const Mesh m = make_closed_cylinder(3.0, 10.0, 8, 4);
+  EXPECT_EQ(m.num_nodes(), 16 * 9);  // 2 n_circ nodes per ring, no duplicate seam
+  EXPECT_EQ(m.num_elements(), 32);
+  for (const Vec3& x : m.X) EXPECT_NEAR(std::hypot(x.y(), x.z()), 3.0, 1e-12);
+  EXPECT_EQ(m.node_sets.at("top").size(), 9u);
+  EXPECT_EQ(m.node_sets.at("bottom").size(), 9u);
+  EXPECT_THROW(make_closed_cylinder(3.0, 10.0, 3, 4), std::invalid_argument);
+}
+
+TEST(MeshGenerators, SlitAnnulusKeepsTheSlitOpen) {
+  const Mesh m = make_slit_annulus(6.0, 10.0, 2, 8);
+  EXPECT_EQ(m.num_nodes(), 5 * 17);  // theta = 0 and 2 pi are distinct nodes
+  const Vec3 a = m.X[static_cast<size_t>(m.node_sets.at("point_A")[0])];
+  const Vec3 b = m.X[static_cast<size_t>(m.node_sets.at("point_B")[0])];
+  EXPECT_EQ(a, Vec3(6.0, 0.0, 0.0));
+  EXPECT_EQ(b, Vec3(10.0, 0.0, 0.0));
+  const auto& s0 = m.node_sets.at("slit_start");
+  const auto& s1 = m.node_sets.at("slit_end");
+  for (size_t k = 0; k < s0.size(); ++k) EXPECT_NE(s0[k], s1[k]);
+  EXPECT_THROW(make_slit_annulus(10.0, 6.0, 2, 8), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace shelldyn

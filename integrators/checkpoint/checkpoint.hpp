@@ -1,0 +1,49 @@
+// Checkpoint files of dynamic runs (docs/architecture.md "Checkpoints and resume").
+//
+// A checkpoint holds everything needed to continue a run as if it had never stopped:
+//   state        t, u, v, a, pdot and the director chart of every node (lib/state.hpp)
+//   integrator   the integrator's own data (Integrator::save: W_ext, history vectors, solver state)
+//   numbers      the run driver's counters and reference quantities (output index, history.csv
+//                size, summary extrema, ...), and the options needed to rebuild the run
+//   texts        the case file's text and where it came from, the command line, ...
+//   vectors      further named vectors of the driver (e.g. the .pvd times)
+// Format: CBOR (RFC 8949) written with nlohmann-json; every double is stored bit for bit (vectors
+// as raw little-endian byte strings), so a resumed run starts from exactly the saved numbers. Files
+// are replaced atomically (temporary + fsync + rename): a run killed while writing keeps the previous
+// checkpoint. read_checkpoint() rejects files of another format or version with one line.
+#pragma once
+
+#include "integrators/integrator.hpp"
+#include "lib/state.hpp"
+
+#include <Eigen/Core>
+
+#include <map>
+#include <string>
+
+namespace shelldyn {
+
+struct Checkpoint {
+  static constexpr int kVersion = 1;
+  State state;
+  std::string integrator;  // name of the integrator that saved `integrator_data`
+  IntegratorCheckpoint integrator_data;
+  std::map<std::string, double> numbers;
+  std::map<std::string, std::string> texts;
+  std::map<std::string, Eigen::VectorXd> vectors;
+
+  double number(const std::string& key) const;                 // throws naming the key if absent
+  const std::string& text(const std::string& key) const;       // likewise
+  const Eigen::VectorXd& vector(const std::string& key) const;  // likewise
+};
+
+// Writes `c` to `path` atomically. Throws std::runtime_error naming the file and the cause.
+void write_checkpoint(const std::string& path, const Checkpoint& c);
+// Reads a checkpoint. Throws std::runtime_error "PATH: ..." if it is missing, truncated, corrupt or
+// of another version.
+Checkpoint read_checkpoint(const std::string& path);
+
+// FNV-1a 64-bit hash as 16 hex digits (identifies case and mesh files in checkpoints).
+std::string content_hash(const std::string& bytes);
+
+}  // namespace shelldyn

@@ -1,0 +1,32 @@
+// The integrator a run would use for a case, built and validated the same way by `shelldyn check`,
+// `shelldyn run` and the benchmark apps, so that `check` rejects exactly what `run` would reject.
+//
+// Errors (std::invalid_argument) point at the case file when the cause is there:
+//   "FILE:LINE: integrator.KEY: reason"   a setting of the case's integrator block
+//   "FILE:LINE: integrator.name: ..."     an unknown integrator name in the case
+//   "--set KEY: reason"                   a command-line override
+// A message is attributed to KEY when it names the key (IntegratorSettings errors always do; range
+// checks of the integrators name the offending setting).
+#pragma once
+
+#include "integrators/integrator.hpp"
+#include "lib/case_file.hpp"
+
+#include <memory>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace shelldyn {
+
+// `integrator`: empty or the case's name = the case's block (with its settings); another name keeps
+// only the case settings that integrator understands (as `shelldyn compare` does). `overrides`: --set.
+std::unique_ptr<Integrator> make_case_integrator(const CaseSpec& spec, const std::string& integrator,
+                                                 const std::vector<std::pair<std::string, std::string>>& overrides,
+                                                 double dt);
+
+// make_case_integrator(spec, "", {}, spec.time.dt), result discarded ("static" passes: it is checked
+// by the static solver).
+void validate_case_integrator(const CaseSpec& spec);
+
+}  // namespace shelldyn
