@@ -187,6 +187,13 @@ TEST(CheckpointNewmark, EmGalphaModifiedNewtonContinuesBitwise) {
   expect_bitwise_continuation("em-galpha", {{"newton", "modified"}, {"setup_every", "3"}}, 7);
   expect_bitwise_continuation("em-galpha", {{"newton", "modified"}, {"setup_every", "3"}}, 1);
 }
+TEST(CheckpointNewmark, EmGalphaModifiedNewtonDefaultsContinueBitwise) {
+  // The modified-Newton defaults: K̄ kept across steps and refreshed by observed contraction, Newmark
+  // predictor, energy floor e_floor·(K_0 + V_0 + |W_ext|) whose K_0 + V_0 (taken at initialize()) must come
+  // from the checkpoint, not from the state the resumed integrator was initialized with.
+  expect_bitwise_continuation("em-galpha", {{"newton", "modified"}}, 7);
+  expect_bitwise_continuation("em-galpha", {{"newton", "modified"}}, 1);
+}
 TEST(CheckpointNewmark, EmGalphaFullNewtonContinuesBitwise) { expect_bitwise_continuation("em-galpha", {}, 5); }
 TEST(CheckpointNewmark, GalphaContinuesBitwise) { expect_bitwise_continuation("galpha", {{"rho_inf", "0.8"}}, 5); }
 TEST(CheckpointNewmark, MidpointContinuesBitwise) { expect_bitwise_continuation("midpoint", {}, 5); }
