@@ -22,6 +22,7 @@
 #include "apps/modes_command.hpp"
 #include "integrators/runs/case_integrator.hpp"
 #include "integrators/runs/compare.hpp"
+#include "integrators/runs/study.hpp"
 #include "integrators/runs/registry.hpp"
 #include "integrators/integrator.hpp"
 #include "integrators/runs/run_driver.hpp"
@@ -479,6 +480,65 @@ void add_compare_command(CLI::App& app, Action& action, const std::string& comma
   sub->add_flag("--no-plots", o->no_plots, "Do not call scripts/plot_compare.py");
   sub->callback([o, &action] { action = [o] { return run_compare(*o); }; });
 }
+
+// --- study -------------------------------------------------------------------------------------------
+// `shelldyn study BENCHMARK`: the integrator study of integrators/runs/study.hpp (work–precision sweep on a
+// window + full-duration conservation runs, resumable), then scripts/plot_study.py. Exit 0 when every run
+// completed, 3 when some failed, 1 for bad input.
+struct StudyCommandOptions {
+  std::string benchmark, case_path, out_dir, command, only = "all";
+  int jobs = 2;
+  bool rerun = false, dry_run = false, no_plots = false;
+};
+
+int run_study_command(const StudyCommandOptions& o) {
+  StudyOptions so;
+  so.preset = study_preset(o.benchmark);
+  so.case_path = o.case_path.empty() ? app::find_case_file(so.preset.case_file) : o.case_path;
+  if (o.jobs < 1) throw std::invalid_argument("--jobs must be >= 1 (got " + std::to_string(o.jobs) + ")");
+  if (o.only == "window" || o.only == "full")
+    so.groups = {o.only};
+  else if (o.only != "all")
+    throw std::invalid_argument("--only must be window, full or all (got '" + o.only + "')");
+  so.out_dir = o.out_dir.empty() ? (fs::path("results") / o.benchmark / "study").string() : o.out_dir;
+  so.rerun = o.rerun;
+  so.dry_run = o.dry_run;
+  so.execution.jobs = o.jobs;
+  so.log = &std::cout;
+  so.command = o.command;
+  if (!o.dry_run) app::check_output_folder(so.out_dir);
+  // Where the runs execute: as `shelldyn compare` (the ranks of mpirun/srun, else --jobs threads).
+  const std::unique_ptr<RunExecutor> executor = app::make_sweep_executor(o.jobs, 0);
+  so.execution.executor = executor.get();
+  so.report = executor->collects();
+  if (!so.report) so.log = nullptr;
+  const StudyResult r = run_study(so);
+  if (o.dry_run || !so.report) return 0;
+  std::cout << "study " << o.benchmark << ": " << r.ran << " runs made, " << r.skipped << " already complete, " << r.failed
+            << " failed; wrote " << r.study_csv << ", " << r.study_md << std::endl;
+  if (!o.no_plots && app::run_python_script(app::find_script("plot_study.py"), {so.out_dir}, std::cout))
+    std::cout << "wrote " << so.out_dir << "/work_precision.png, full_energy.png, full_momentum.png" << std::endl;
+  return r.failed ? 3 : 0;
+}
+
+void add_study_command(CLI::App& app, Action& action, const std::string& command) {
+  auto o = std::make_shared<StudyCommandOptions>();
+  o->command = command;
+  std::string names;
+  for (const auto& p : study_presets()) names += (names.empty() ? "" : "|") + p.name;
+  CLI::App* sub = app.add_subcommand(
+      "study", "Work-precision sweep of every integrator on a benchmark + full-duration conservation runs (resumable); "
+               "write study.csv, study.md and plots");
+  sub->add_option("benchmark", o->benchmark, "Benchmark: " + names)->required();
+  sub->add_option("--case", o->case_path, "Case file to use instead of apps/cases/<benchmark>.yaml (same preset)");
+  sub->add_option("-o,--output", o->out_dir, "Result folder (default: results/<benchmark>/study)");
+  sub->add_option("--jobs", o->jobs, "Runs at a time, each single-threaded (default 2)");
+  sub->add_option("--only", o->only, "Run only the group window (work-precision sweep) or full (full duration); default all");
+  sub->add_flag("--rerun", o->rerun, "Run completed runs again (default: keep them; the study resumes)");
+  sub->add_flag("--dry-run", o->dry_run, "List the runs and which are complete; run nothing");
+  sub->add_flag("--no-plots", o->no_plots, "Do not call scripts/plot_study.py");
+  sub->callback([o, &action] { action = [o] { return run_study_command(*o); }; });
+}
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -496,6 +556,7 @@ int main(int argc, char** argv) {
   add_static_command(app, action, command);
   app::add_modes_command(app, action, command);
   add_compare_command(app, action, command);
+  add_study_command(app, action, command);
   add_resume_command(app, action, command);
 
   try {

@@ -23,6 +23,7 @@
 #include <map>
 #include <memory>
 #include <stdexcept>
+#include <ostream>
 #include <string>
 #include <utility>
 #include <vector>
@@ -85,6 +86,11 @@ class Integrator {
 
   // External work done on the system since initialize(), evaluated consistently with the scheme.
   virtual double external_work() const = 0;
+
+  // Where to print progress lines while advance() runs long (adaptive integrators between output times);
+  // null: none; in_place: the log is a terminal whose current line the run driver rewrites ('\r'), so
+  // write the same way. The default ignores it.
+  virtual void set_progress_log(std::ostream* /*log*/, const std::string& /*label*/, bool /*in_place*/ = false) {}
   // Work dissipated by Rayleigh damping so far, Σ Δqᵀ C q̇ with the scheme's own velocity (docs/theory.md
   // §8.5); H = K + V − W_ext + W_damp is then the conserved total. 0 for integrators that do not track it.
   virtual double damping_work() const { return 0.0; }

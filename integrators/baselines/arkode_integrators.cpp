@@ -1,6 +1,6 @@
 #include "integrators/baselines/arkode_integrators.hpp"
 
-#include "integrators/baselines/first_order_system.hpp"
+#include "integrators/baselines/sundials_baseline.hpp"
 #include "integrators/sundials/sundials_support.hpp"
 #include "lib/assembler.hpp"
 
@@ -23,35 +23,19 @@ struct ArkCounters {
   long steps = 0, attempts = 0, fe = 0, fi = 0, newton = 0, setups = 0;
 };
 
-class ArkodeIntegrator final : public Integrator {
+class ArkodeIntegrator final : public SundialsBaseline {
  public:
-  ArkodeIntegrator(IntegratorSettings& s, double dt, bool implicit) : implicit_(implicit), dt_(dt) {
-    name_ = implicit ? "arkode-dirk" : "arkode-erk";
+  ArkodeIntegrator(IntegratorSettings& s, double dt, bool implicit)
+      : SundialsBaseline(implicit ? "arkode-dirk" : "arkode-erk", s), implicit_(implicit), dt_(dt) {
     table_ = s.get("table", implicit ? "ARKODE_ESDIRK547L2SA_7_4_5" : "ARKODE_DORMAND_PRINCE_7_4_5");
-    rtol_ = s.get("rtol", 1e-6);
-    atol_ = s.get("atol", 1e-9);
     fixed_ = s.get("fixed_step", false);
-    max_step_ = s.get("max_step", 0.0);
-    init_step_ = s.get("init_step", 0.0);
-    max_steps_ = s.get("max_steps", 1e8);
-    mass_solver_ = s.get("mass_solver", "eigen-ldlt");
-    chart_overshoot_ = s.get("chart_overshoot", 0.05);
-    if (!(chart_overshoot_ >= 0.0 && chart_overshoot_ < 0.3))
-      throw std::invalid_argument(name_ + ": chart_overshoot must be in [0, 0.3), got " + std::to_string(chart_overshoot_));
     if (implicit) {
       linear_solver_ = s.get("linear_solver", "eigen-ldlt");
       max_nonlin_ = s.get("max_nonlin_iters", 3);
       lsetup_frequency_ = s.get("lsetup_frequency", 0);
     }
-    check_tolerances(name_, rtol_, atol_);
-    if (!(max_step_ >= 0.0) || !(init_step_ >= 0.0))
-      throw std::invalid_argument(name_ + ": max_step and init_step must be >= 0 (0 = ARKODE's choice)");
-    if (!(max_steps_ >= 1.0)) throw std::invalid_argument(name_ + ": max_steps must be >= 1");
     if (fixed_ && !(dt_ > 0.0 && std::isfinite(dt_)))
       throw std::invalid_argument(name_ + ": fixed_step needs a positive time step dt, got " + std::to_string(dt_));
-    if (mass_solver_ != "eigen-ldlt" && mass_solver_ != "cholmod")
-      throw std::invalid_argument(name_ + ": mass_solver '" + mass_solver_ +
-                                  "' is not valid (the mass matrix is SPD: use eigen-ldlt or cholmod)");
     if (implicit) {
       const auto names = linear_solver_names();
       if (std::find(names.begin(), names.end(), linear_solver_) == names.end())
@@ -89,44 +73,13 @@ class ArkodeIntegrator final : public Integrator {
 
   ~ArkodeIntegrator() override { free_ark(); }
 
-  std::string name() const override { return name_; }
-  std::vector<std::pair<std::string, std::string>> settings() const override { return resolved_; }
-  double external_work() const override { return w_; }
-
-  // Checkpoint by re-initialization (docs/architecture.md "Checkpoints and resume"): only W_ext at the
-  // last output time is saved; restore() restarts SUNDIALS from the saved State as after a chart
-  // event. The step-size and order history is lost, so a resumed run agrees with an uninterrupted one
-  // to the tolerances (rtol, atol), not bitwise.
-  void save(IntegratorCheckpoint& c) const override {
-    c.exact = false;
-    c.scalars["W_ext"] = w_out_;
-  }
-  void restore(SemiDiscreteSystem& system, State& state, const IntegratorCheckpoint& c) override {
-    if (mem_ == nullptr) throw std::logic_error(name() + ": restore() before initialize()");
-    sys_ = &system;
-    w_ = w_out_ = c.scalar("W_ext");
-    StepReport ignored;
-    restart_from(state, ignored);
-  }
-
-  void initialize(SemiDiscreteSystem& system, State& state) override {
+ private:
+  // --- SundialsBaseline hooks ---
+  void create_solver(SemiDiscreteSystem& system, const State& state) override {
     free_ark();
-    sys_ = &system;
-    ctx_ = std::make_unique<SunContext>();
-    fos_ = std::make_unique<FirstOrderSystem>(system, mass_solver_);
-    n_ = system.num_dofs();
     const Index N = 2 * n_ + 1;
-    if (system.chart_margin(state) < 0.0) system.rechart(state);
-    fos_->acceleration(state.t, state, state.a);
-    w_ = w_out_ = 0.0;
-    stop_hit_ = false;
-    t_ = state.t;
-    work_ = state;
     y_ = make_serial_vector(N, *ctx_);
-    atol_v_ = make_serial_vector(N, *ctx_);
     fos_->pack(state, w_, data(y_.get()));
-    fos_->absolute_tolerances(state, atol_, data(atol_v_.get()));
-
     mem_ = implicit_ ? ARKStepCreate(nullptr, rhs, t_, y_.get(), *ctx_) : ARKStepCreate(rhs, nullptr, t_, y_.get(), *ctx_);
     check_ptr(mem_, "ARKStepCreate");
     check(ARKStepSetErrHandlerFn(mem_, record_sundials_error, &sundials_message_), "ARKStepSetErrHandlerFn");
@@ -147,92 +100,31 @@ class ArkodeIntegrator final : public Integrator {
     if (implicit_) setup_newton_solver(system);
     base_ = ArkCounters{};
   }
-
-  StepReport advance(SemiDiscreteSystem& system, State& state, double t_out) override {
-    if (mem_ == nullptr) throw std::logic_error(name_ + ": advance() before initialize()");
-    const auto wall0 = std::chrono::steady_clock::now();
-    sys_ = &system;
-    StepReport rep;
-    const long fact0 = factorizations();
-    if (!in_sync(state)) restart_from(state, rep);
-    if (t_out < t_) {
-      std::ostringstream os;
-      os << name_ << ": t_out = " << t_out << " is before the current time " << t_;
-      throw std::invalid_argument(os.str());
-    }
-    const double t_tol = 1e-12 * std::max(1.0, std::abs(t_out));
-    while (t_out - t_ > t_tol) {
-      check(ARKStepSetStopTime(mem_, t_out), "ARKStepSetStopTime");
-      errors_.clear();
-      sundials_message_.clear();
-      double tret = t_;
-      const int flag = ARKStepEvolve(mem_, t_out, y_.get(), &tret, ARK_NORMAL);
-      if (flag < 0) {
-        add_counters(rep);
-        if (stop_hit_) {  // stop request (signal, --max-wall): state is still the last output state
-          stop_hit_ = false;
-          std::ostringstream os;
-          os << name() << ": stopped on request at t = " << tret << " (state kept at t = " << state.t << ")";
-          throw RunInterrupted(os.str());
-        }
-        fail(flag, tret);
-      }
-      t_ = tret;
-      if (!all_finite(data(y_.get()), 2 * n_ + 1)) {
-        add_counters(rep);
-        fail(ARK_SUCCESS, tret, "non-finite solution");
-      }
-      if (flag == ARK_ROOT_RETURN) {
-        ++rep.root_events;
-        read_y(work_);
-        fos_->acceleration(t_, work_, work_.a);
-        const int switched = system.rechart(work_);
-        rep.chart_switches += switched;
-        if (switched > 0) {
-          add_counters(rep);
-          fos_->pack(work_, w_, data(y_.get()));
-          check(ARKStepReInit(mem_, implicit_ ? nullptr : rhs, implicit_ ? rhs : nullptr, t_, y_.get()),
-                "ARKStepReInit");
-          base_ = ArkCounters{};
-          ++rep.reinitializations;
-        }
-      }
-    }
-    add_counters(rep);
-    read_y(work_);
-    work_.t = t_out;
-    t_ = t_out;
-    fos_->acceleration(t_, work_, work_.a);  // state.a = v̇(t_out)
-    state = work_;
-    double h = 0;
-    ARKStepGetLastStep(mem_, &h);
-    rep.last_dt = h;
-    rep.factorizations = factorizations() - fact0;
-    w_out_ = w_;
-    rep.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
-    return rep;
+  void set_stop_time(double t_out) override { check(ARKStepSetStopTime(mem_, t_out), "ARKStepSetStopTime"); }
+  int one_step(double t_out, double& tret) override { return ARKStepEvolve(mem_, t_out, y_.get(), &tret, ARK_ONE_STEP); }
+  StepOutcome outcome(int flag) const override {
+    return flag == ARK_ROOT_RETURN ? StepOutcome::root : flag == ARK_TSTOP_RETURN ? StepOutcome::reached : StepOutcome::step;
   }
-
- private:
-  void read_y(State& s) {
+  void pack(const State& s) override { fos_->pack(s, w_, data(y_.get())); }
+  void reinit() override {
+    check(ARKStepReInit(mem_, implicit_ ? nullptr : rhs, implicit_ ? rhs : nullptr, t_, y_.get()), "ARKStepReInit");
+  }
+  void unpack(State& s) override {
     const double* y = data(y_.get());
     fos_->unpack(y, s);
     s.t = t_;
     w_ = y[2 * n_];
   }
-
-  bool in_sync(const State& s) const { return state_in_sync(s, t_, work_, data(y_.get()), n_); }
-  void restart_from(State& s, StepReport& rep) {
-    add_counters(rep);
-    t_ = s.t;
-    work_ = s;
-    fos_->pack(s, w_, data(y_.get()));
-    check(ARKStepReInit(mem_, implicit_ ? nullptr : rhs, implicit_ ? rhs : nullptr, t_, y_.get()), "ARKStepReInit");
-    base_ = ArkCounters{};
-    ++rep.reinitializations;
+  bool acceleration_in_y() const override { return false; }
+  void rebase_counters() override { base_ = ArkCounters{}; }
+  double last_step() const override {
+    double h = 0;
+    ARKStepGetLastStep(mem_, &h);
+    return h;
   }
+  const double* y() const override { return N_VGetArrayPointer(y_.get()); }
 
-  long factorizations() const {
+  long factorizations() const override {
     long f = fos_->mass_factorizations();
     if (newton_solver_) f += newton_solver_->stats().factorizations;
     return f;
@@ -249,7 +141,7 @@ class ArkodeIntegrator final : public Integrator {
     }
     return c;
   }
-  void add_counters(StepReport& rep) {
+  void add_counters(StepReport& rep) override {
     const ArkCounters c = counters();
     rep.steps += c.steps - base_.steps;
     rep.rejected_steps += (c.attempts - base_.attempts) - (c.steps - base_.steps);
@@ -259,7 +151,7 @@ class ArkodeIntegrator final : public Integrator {
     base_ = c;
   }
 
-  [[noreturn]] void fail(int flag, double t, const std::string& what = "") {
+  [[noreturn]] void fail(int flag, double t, const std::string& what) override {
     double h = 0;
     ARKStepGetCurrentStep(mem_, &h);
     std::ostringstream os;
@@ -406,10 +298,6 @@ class ArkodeIntegrator final : public Integrator {
   // --- RHS, root and post-step callbacks: no exception crosses them ---
   static int rhs(sunrealtype t, N_Vector y, N_Vector ydot, void* ud) {
     auto* self = static_cast<ArkodeIntegrator*>(ud);
-    if (self->stop_requested()) {  // signal or --max-wall: abandon the interval (unrecoverable)
-      self->stop_hit_ = true;
-      return -1;
-    }
     try {
       const Index n = self->n_;
       const double* yv = N_VGetArrayPointer(y);
@@ -445,8 +333,7 @@ class ArkodeIntegrator final : public Integrator {
   static int root(sunrealtype, N_Vector y, sunrealtype* g, void* ud) {
     auto* self = static_cast<ArkodeIntegrator*>(ud);
     try {
-      self->fos_->unpack(N_VGetArrayPointer(y), self->work_);
-      g[0] = self->sys_->chart_margin(self->work_) + self->chart_overshoot_;
+      g[0] = self->chart_root(N_VGetArrayPointer(y));
       return 0;
     } catch (...) {
       self->errors_.capture("chart-margin root function");
@@ -474,26 +361,15 @@ class ArkodeIntegrator final : public Integrator {
   // settings
   bool implicit_;
   double dt_;
-  std::string name_, table_, mass_solver_, linear_solver_;
-  double rtol_ = 0, atol_ = 0, max_step_ = 0, init_step_ = 0, max_steps_ = 0, chart_overshoot_ = 0.05;
+  std::string table_, linear_solver_;
   bool fixed_ = false;
   int max_nonlin_ = 3, lsetup_frequency_ = 0;
-  std::vector<std::pair<std::string, std::string>> resolved_;
 
-  // run objects (ctx_ first: freed last)
-  std::unique_ptr<SunContext> ctx_;
-  NVectorPtr y_, atol_v_;
+  // run objects
+  NVectorPtr y_;
   SunMatrixPtr A_;
   SunLinearSolverPtr LS_;
   void* mem_ = nullptr;
-
-  SemiDiscreteSystem* sys_ = nullptr;
-  std::unique_ptr<FirstOrderSystem> fos_;
-  Index n_ = 0;
-  State work_;
-  double t_ = 0.0, w_ = 0.0;
-  double w_out_ = 0.0;      // W_ext at the end of the last advance() (checkpoints)
-  bool stop_hit_ = false;   // a callback saw stop_requested()
   Eigen::VectorXd a_;
 
   // Newton solver of arkode-dirk
@@ -504,8 +380,6 @@ class ArkodeIntegrator final : public Integrator {
   Eigen::VectorXd bq_, rhs_, tmp_, xq_;
 
   ArkCounters base_;
-  CallbackError errors_;
-  std::string sundials_message_;
 };
 
 }  // namespace

@@ -28,15 +28,18 @@
 // (ARKStepSetFixedStep). Explicit fixed-step runs past the stability limit would silently produce NaN
 // (docs/dependencies.md §7 item 11): a post-step hook checks every step and the run stops with a StepFailure.
 //
-// Director charts (docs/theory.md §2.3): root function g = chart_margin(state(y)) + δ (δ = chart_overshoot, see
-// ida_bdf.hpp), direction −1; at a root the state is written back, system.rechart() converts it, ARKStepReInit restarts from it.
+// Director charts, tolerances, progress output and the evolve / root-event / re-init loop: shared with
+// ida-bdf (integrators/baselines/sundials_baseline.hpp).
 //
-// Settings: table [ARKODE_DORMAND_PRINCE_7_4_5 (erk) | ARKODE_ESDIRK547L2SA_7_4_5 (dirk)];
-// rtol [1e-6]; atol [1e-9] (scaled per block as in FirstOrderSystem::absolute_tolerances);
-// fixed_step [false]; max_step [0 = none]; init_step [0 = ARKODE's choice]; max_steps [1e8];
-// mass_solver [eigen-ldlt]; linear_solver [eigen-ldlt] (dirk only); max_nonlin_iters [3] and lsetup_frequency
-// [0 = ARKODE default, a new Jacobian every 20 steps] (dirk only);
-// chart_overshoot [0.05].
+// Mass solves: every RHS evaluation needs M(q)⁻¹; FirstOrderSystem reuses the last factorization of M as a
+// preconditioner of an iterative refinement to a 1e-12 residual and refactorizes only when the refinement
+// stalls (mass_reuse, default true; first_order_system.hpp).
+//
+// Settings (plus the common ones: rtol, atol, length_scale, time_scale, max_step, init_step, max_steps,
+// chart_overshoot, mass_solver, mass_reuse, progress_every):
+// table [ARKODE_DORMAND_PRINCE_7_4_5 (erk) | ARKODE_ESDIRK547L2SA_7_4_5 (dirk)]; fixed_step [false];
+// linear_solver [eigen-ldlt], max_nonlin_iters [3] and lsetup_frequency [0 = ARKODE default, a new
+// Jacobian every 20 steps] (dirk only).
 #pragma once
 
 #include "integrators/integrator.hpp"

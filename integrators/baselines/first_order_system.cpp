@@ -1,16 +1,18 @@
 #include "integrators/baselines/first_order_system.hpp"
 
 #include "lib/assembler.hpp"
+#include "lib/model.hpp"
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <sstream>
 #include <stdexcept>
 
 namespace shelldyn {
 
-FirstOrderSystem::FirstOrderSystem(SemiDiscreteSystem& system, const std::string& mass_solver)
-    : system_(&system), n_(system.num_dofs()) {
+FirstOrderSystem::FirstOrderSystem(SemiDiscreteSystem& system, const std::string& mass_solver, bool mass_reuse)
+    : system_(&system), n_(system.num_dofs()), mass_reuse_(mass_reuse) {
   // M is SPD: a one-triangle Cholesky/LDLᵀ back-end is both valid and the fastest (docs/dependencies.md §5.4).
   if (mass_solver != "eigen-ldlt" && mass_solver != "cholmod")
     throw std::invalid_argument("mass_solver: '" + mass_solver +
@@ -22,6 +24,8 @@ FirstOrderSystem::FirstOrderSystem(SemiDiscreteSystem& system, const std::string
   f_m_.resize(n_);
   f_ext_.resize(n_);
   rhs_.resize(n_);
+  res_.resize(n_);
+  corr_.resize(n_);
 }
 
 void FirstOrderSystem::pack(const State& s, double w, double* y) const {
@@ -50,10 +54,30 @@ double FirstOrderSystem::acceleration(double t, const State& s, Eigen::VectorXd&
   // Rows and columns of constrained DOFs become identity with a zero right-hand side: a_c = 0, and
   // since a_c = 0 the dropped columns M_fc a_c contribute nothing (exact, not an approximation).
   apply_dirichlet(sys.dofs(), M_, rhs_.data(), 1.0);
-  mass_solver_->factorize(M_.view());
-  a.resize(n_);
-  mass_solver_->solve(rhs_.data(), a.data());
+  solve_mass(a);
   return f_ext_.dot(s.v);
+}
+
+void FirstOrderSystem::solve_mass(Eigen::VectorXd& a) {
+  a.resize(n_);
+  if (mass_reuse_ && mass_solver_->factorized()) {
+    const double target = 1e-12 * rhs_.cwiseAbs().maxCoeff() + 1e-300;
+    mass_solver_->solve(rhs_.data(), a.data());
+    double previous = std::numeric_limits<double>::infinity();
+    for (int k = 0; k <= 4; ++k) {
+      multiply(M_.view(), a.data(), res_.data());
+      res_ = rhs_ - res_;
+      const double r = res_.cwiseAbs().maxCoeff();
+      if (r <= target) return;
+      if (k == 4 || !(r < 0.25 * previous)) break;  // too slow: M(q) moved away from M₀
+      previous = r;
+      mass_solver_->solve(res_.data(), corr_.data());
+      a += corr_;
+      ++refinements_;
+    }
+  }
+  mass_solver_->factorize(M_.view());
+  mass_solver_->solve(rhs_.data(), a.data());
 }
 
 double FirstOrderSystem::momentum_residual(double t, const State& s, const Eigen::VectorXd& a,
@@ -70,13 +94,56 @@ double FirstOrderSystem::momentum_residual(double t, const State& s, const Eigen
   return f_ext_.dot(s.v);
 }
 
-void FirstOrderSystem::absolute_tolerances(const State& s0, double atol, double* out) const {
-  const double vscale = std::max(1.0, s0.v.size() ? s0.v.cwiseAbs().maxCoeff() : 0.0);
+FirstOrderSystem::ToleranceScales FirstOrderSystem::tolerance_scales(const State& s0, double length_scale,
+                                                                     double time_scale) {
+  ToleranceScales sc;
+  sc.length = length_scale;
+  sc.shell = dynamic_cast<const Model*>(system_) != nullptr;
+  if (!(sc.length > 0.0)) {
+    sc.length = 1.0;
+    if (const auto* model = dynamic_cast<const Model*>(system_)) {
+      sc.shell = true;
+      const auto& X = model->mesh().X;
+      if (!X.empty()) {
+        Eigen::Vector3d lo = X[0], hi = X[0];
+        for (const auto& x : X) {
+          lo = lo.cwiseMin(x);
+          hi = hi.cwiseMax(x);
+        }
+        if ((hi - lo).norm() > 0.0) sc.length = (hi - lo).norm();
+      }
+    }
+  }
+  sc.time = time_scale > 0.0 ? time_scale : 1.0;
+  sc.velocity = sc.length / sc.time;
+  system_->mass(s0.u, s0.charts, M_);
+  double mass = 0.0;  // eᵀ M e for rigid unit translations e along X, Y, Z, averaged: the total mass
+  const SparsePattern& P = *M_.pattern;
+  for (Index j = 0; j < n_; ++j) {
+    const Index cj = sc.shell ? j % kDofsPerNode : 0;
+    if (cj >= 3) continue;
+    for (Index k = P.colptr[j]; k < P.colptr[j + 1]; ++k) {
+      const Index i = P.rowind[k];
+      if ((sc.shell ? i % kDofsPerNode : 0) == cj) mass += M_.values[static_cast<size_t>(k)];
+    }
+  }
+  if (sc.shell) mass /= 3.0;
   const Invariants inv = system_->invariants(s0);
-  const double escale = std::max(1.0, inv.kinetic + std::abs(inv.strain));
-  std::fill(out, out + n_, atol);
-  std::fill(out + n_, out + 2 * n_, atol * vscale);
-  out[2 * n_] = atol * escale;
+  // Not m (L/τ)²: a body that starts at rest may move far less than L/τ suggests (hemisphere at ρ = 1000),
+  // and a loose tolerance on W_ext shows directly in the energy balance.
+  (void)mass;
+  sc.energy = std::max(1.0, inv.kinetic + std::abs(inv.strain));
+  if (!(sc.energy > 0.0)) sc.energy = 1.0;
+  return sc;
+}
+
+void FirstOrderSystem::absolute_tolerances(const ToleranceScales& sc, double atol, double* out) const {
+  for (Index i = 0; i < n_; ++i) {
+    const bool translation = !sc.shell || i % kDofsPerNode < 3;
+    out[i] = atol * (translation ? sc.length : 1.0);
+    out[n_ + i] = atol * (translation ? sc.velocity : 1.0 / sc.time);
+  }
+  out[2 * n_] = atol * sc.energy;
 }
 
 bool all_finite(const double* x, Index n) {

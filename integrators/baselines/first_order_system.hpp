@@ -8,8 +8,17 @@
 // so q_c stays at its initial value and every component stays differential.
 //
 // FirstOrderSystem owns the work storage (M, force vectors) and one LinearSolver for the mass matrix
-// ("eigen-ldlt" or "cholmod": M is SPD; one symbolic analysis per object, a numeric factorization per
-// acceleration()). It keeps no charts: callers pass the State whose charts are current.
+// ("eigen-ldlt" or "cholmod": M is SPD; one symbolic analysis per object). It keeps no charts: callers
+// pass the State whose charts are current.
+//
+// Mass solves (mass_reuse, default on): M(q) changes slowly with q (only its director rows depend on the
+// configuration), so acceleration() does not refactorize M(q) for every call. It solves M(q) a = r by
+// iterative refinement preconditioned with the last factorization M₀⁻¹,
+//     a ← a + M₀⁻¹ (r − M(q) a),
+// and stops when ‖r − M(q) a‖∞ ≤ 1e-12 ‖r‖∞ (+ 1e-300): the answer is the solution of the CURRENT M(q)
+// to that residual, not an approximation by M₀. When the iteration does not reach the tolerance within
+// 4 corrections or contracts by less than 0.25 per correction, M(q) is refactorized and becomes the new M₀.
+// mass_factorizations() counts the factorizations, mass_refinements() the corrections.
 #pragma once
 
 #include "lib/linear_solver.hpp"
@@ -25,7 +34,7 @@ namespace shelldyn {
 class FirstOrderSystem {
  public:
   // Throws std::invalid_argument for an unknown or unsuitable mass_solver (names the setting).
-  FirstOrderSystem(SemiDiscreteSystem& system, const std::string& mass_solver);
+  FirstOrderSystem(SemiDiscreteSystem& system, const std::string& mass_solver, bool mass_reuse = true);
 
   SemiDiscreteSystem& system() const { return *system_; }
   Index n() const { return n_; }
@@ -43,21 +52,36 @@ class FirstOrderSystem {
   // Residual of the momentum rows for IDA: r = M(q) a + F_m + F_int − F_ext, r_c = a_c; returns F_ext·v.
   double momentum_residual(double t, const State& s, const Eigen::VectorXd& a, Eigen::VectorXd& r);
 
-  // Absolute tolerances per component (spec of the `atol` setting, shared by all three baselines):
-  //   q entries: atol (translations in the case's length unit, director components dimensionless),
-  //   v entries: atol · max(1, ‖v₀‖∞)   (velocity scale of the initial state),
-  //   w:         atol · max(1, K₀ + |V₀|) (energy scale of the initial state).
-  void absolute_tolerances(const State& s0, double atol, double* out) const;
+  // Scales of the absolute tolerances per variable kind (docs/results.md, "Baseline tuning"):
+  //   translations d:     length L (diagonal of the initial mesh's bounding box; 1 for systems without a mesh,
+  //                       where every q entry counts as a translation)
+  //   director unknowns:  1 (components of a unit vector)
+  //   velocities ḋ:       L/τ,  director rates: 1/τ   (τ: time scale, see the baselines' time_scale setting)
+  //   external work w:    max(1, K₀ + |V₀|)
+  struct ToleranceScales {
+    double length = 1.0, time = 1.0, velocity = 1.0, energy = 1.0;
+    bool shell = false;  // a shell Model: 5 DOFs per node, [d_X, d_Y, d_Z, q_1, q_2]
+  };
+  // length_scale / time_scale <= 0: automatic (L from the mesh; τ = 1).
+  ToleranceScales tolerance_scales(const State& s0, double length_scale, double time_scale);
+  // atol_k = atol · scale_k for every component of y = [q; v; w].
+  void absolute_tolerances(const ToleranceScales& scales, double atol, double* out) const;
 
   long mass_factorizations() const { return mass_solver_->stats().factorizations; }
+  long mass_refinements() const { return refinements_; }
   const SparseMatrix& last_mass() const { return M_; }
 
  private:
   SemiDiscreteSystem* system_;
   Index n_;
+  // a = M(q)⁻¹ rhs_ into a (M_ assembled, constraints applied): refinement with M₀ or a refactorization.
+  void solve_mass(Eigen::VectorXd& a);
+
   std::unique_ptr<LinearSolver> mass_solver_;
+  bool mass_reuse_ = true;
+  long refinements_ = 0;
   SparseMatrix M_;
-  Eigen::VectorXd f_int_, f_m_, f_ext_, rhs_;
+  Eigen::VectorXd f_int_, f_m_, f_ext_, rhs_, res_, corr_;
 };
 
 // True if all n values are finite.

@@ -1,6 +1,6 @@
 #include "integrators/baselines/ida_bdf.hpp"
 
-#include "integrators/baselines/first_order_system.hpp"
+#include "integrators/baselines/sundials_baseline.hpp"
 #include "integrators/sundials/sun_linear_solver.hpp"
 #include "integrators/sundials/sundials_support.hpp"
 #include "lib/assembler.hpp"
@@ -20,26 +20,15 @@ struct IdaCounters {
   long steps = 0, residuals = 0, newton = 0, conv_fails = 0, err_fails = 0, setups = 0;
 };
 
-class IdaBdf final : public Integrator {
+class IdaBdf final : public SundialsBaseline {
  public:
-  IdaBdf(IntegratorSettings& s, double /*dt: IDA chooses its own steps (init_step)*/) {
-    rtol_ = s.get("rtol", 1e-6);
-    atol_ = s.get("atol", 1e-9);
-    max_order_ = s.get("max_order", 5);
-    max_step_ = s.get("max_step", 0.0);
-    init_step_ = s.get("init_step", 0.0);
+  IdaBdf(IntegratorSettings& s, double /*dt: IDA chooses its own steps (init_step)*/) : SundialsBaseline("ida-bdf", s) {
+    max_order_ = s.get("max_order", 2);
     linear_solver_ = s.get("linear_solver", "klu");
     jacobian_ = s.get("jacobian", "approximate");
-    mass_solver_ = s.get("mass_solver", "eigen-ldlt");
-    max_steps_ = s.get("max_steps", 1e8);
-    chart_overshoot_ = s.get("chart_overshoot", 0.05);
-    check_tolerances("ida-bdf", rtol_, atol_);
-    if (!(chart_overshoot_ >= 0.0 && chart_overshoot_ < 0.3))
-      throw std::invalid_argument("ida-bdf: chart_overshoot must be in [0, 0.3), got " + std::to_string(chart_overshoot_));
+    dcj_lsetup_ = s.get("delta_cj_lsetup", 0.25);
     if (max_order_ < 1 || max_order_ > 5)
       throw std::invalid_argument("ida-bdf: max_order must be 1..5, got " + std::to_string(max_order_));
-    if (!(max_step_ >= 0.0) || !(init_step_ >= 0.0))
-      throw std::invalid_argument("ida-bdf: max_step and init_step must be >= 0 (0 = IDA's choice)");
     if (linear_solver_ != "klu")
       throw std::invalid_argument("ida-bdf: linear_solver '" + linear_solver_ +
                                   "' is not supported: the IDA iteration matrix [[c_j I, -I], [K, c_j M]] is "
@@ -47,62 +36,27 @@ class IdaBdf final : public Integrator {
     if (jacobian_ != "approximate" && jacobian_ != "fd-inertia")
       throw std::invalid_argument("ida-bdf: jacobian must be 'approximate' or 'fd-inertia', got '" + jacobian_ +
                                   "'");
-    if (mass_solver_ != "eigen-ldlt" && mass_solver_ != "cholmod")
-      throw std::invalid_argument("ida-bdf: mass_solver '" + mass_solver_ +
-                                  "' is not valid (the mass matrix is SPD: use eigen-ldlt or cholmod)");
-    if (!(max_steps_ >= 1.0)) throw std::invalid_argument("ida-bdf: max_steps must be >= 1");
+    if (!(dcj_lsetup_ > 0.0 && dcj_lsetup_ < 1.0))
+      throw std::invalid_argument("ida-bdf: delta_cj_lsetup must be in (0, 1), got " + std::to_string(dcj_lsetup_));
     resolved_ = s.resolved();
   }
 
   ~IdaBdf() override { free_ida(); }
 
-  std::string name() const override { return "ida-bdf"; }
-  std::vector<std::pair<std::string, std::string>> settings() const override { return resolved_; }
-  double external_work() const override { return w_; }
-
-  // Checkpoint by re-initialization (docs/architecture.md "Checkpoints and resume"): only W_ext at the
-  // last output time is saved; restore() restarts SUNDIALS from the saved State as after a chart
-  // event. The step-size and order history is lost, so a resumed run agrees with an uninterrupted one
-  // to the tolerances (rtol, atol), not bitwise.
-  void save(IntegratorCheckpoint& c) const override {
-    c.exact = false;
-    c.scalars["W_ext"] = w_out_;
-  }
-  void restore(SemiDiscreteSystem& system, State& state, const IntegratorCheckpoint& c) override {
-    if (mem_ == nullptr) throw std::logic_error(name() + ": restore() before initialize()");
-    sys_ = &system;
-    w_ = w_out_ = c.scalar("W_ext");
-    StepReport ignored;
-    restart_from(state, ignored);
-  }
-
-  void initialize(SemiDiscreteSystem& system, State& state) override {
+ private:
+  // --- SundialsBaseline hooks ---
+  void create_solver(SemiDiscreteSystem& system, const State& state) override {
     free_ida();
-    sys_ = &system;
-    ctx_ = std::make_unique<SunContext>();
-    fos_ = std::make_unique<FirstOrderSystem>(system, mass_solver_);
-    n_ = system.num_dofs();
     const Index N = 2 * n_ + 1;
     build_block_pattern(*system.pattern());
     K_.pattern = M_.pattern = G_v_.pattern = system.pattern();
     K_.values.assign(static_cast<size_t>(system.pattern()->nnz()), 0.0);
     M_.values = G_v_.values = K_.values;
     fext_.resize(n_);
-
-    // A director past its chart's margin at the start: switch first (docs/theory.md §2.3).
-    if (system.chart_margin(state) < 0.0) system.rechart(state);
-    fos_->acceleration(state.t, state, state.a);
-    w_ = w_out_ = 0.0;
-    stop_hit_ = false;
-    t_ = state.t;
-    work_ = state;
-
     y_ = make_serial_vector(N, *ctx_);
     yp_ = make_serial_vector(N, *ctx_);
     id_ = make_serial_vector(N, *ctx_);
-    atol_v_ = make_serial_vector(N, *ctx_);
     write_y(state);
-    fos_->absolute_tolerances(state, atol_, data(atol_v_.get()));
     N_VConst(1.0, id_.get());
     J_ = make_csc_matrix(*big_.pattern, *ctx_);
     LS_.reset(make_sun_linear_solver(*ctx_, make_linear_solver(linear_solver_)));
@@ -117,6 +71,7 @@ class IdaBdf final : public Integrator {
     check(IDASetJacFn(mem_, jacobian), "IDASetJacFn");
     check(IDASetId(mem_, id_.get()), "IDASetId");
     check(IDASetMaxOrd(mem_, max_order_), "IDASetMaxOrd");
+    check(IDASetDeltaCjLSetup(mem_, dcj_lsetup_), "IDASetDeltaCjLSetup");
     if (max_step_ > 0) check(IDASetMaxStep(mem_, max_step_), "IDASetMaxStep");
     if (init_step_ > 0) check(IDASetInitStep(mem_, init_step_), "IDASetInitStep");
     check(IDASetMaxNumSteps(mem_, static_cast<long>(max_steps_)), "IDASetMaxNumSteps");
@@ -126,70 +81,26 @@ class IdaBdf final : public Integrator {
     check(IDASetNoInactiveRootWarn(mem_), "IDASetNoInactiveRootWarn");
     base_ = IdaCounters{};
   }
-
-  StepReport advance(SemiDiscreteSystem& system, State& state, double t_out) override {
-    if (mem_ == nullptr) throw std::logic_error("ida-bdf: advance() before initialize()");
-    const auto wall0 = std::chrono::steady_clock::now();
-    sys_ = &system;
-    StepReport rep;
-    const long fact0 = sun_linear_solver_backend(LS_.get()).stats().factorizations;
-    if (!in_sync(state)) restart_from(state, rep);
-    if (t_out < t_) {
-      std::ostringstream os;
-      os << "ida-bdf: t_out = " << t_out << " is before the current time " << t_;
-      throw std::invalid_argument(os.str());
-    }
-    const double t_tol = 1e-12 * std::max(1.0, std::abs(t_out));
-    while (t_out - t_ > t_tol) {
-      check(IDASetStopTime(mem_, t_out), "IDASetStopTime");
-      errors_.clear();
-      sundials_message_.clear();
-      double tret = t_;
-      const int flag = IDASolve(mem_, t_out, &tret, y_.get(), yp_.get(), IDA_NORMAL);
-      if (flag < 0) {
-        add_counters(rep);
-        if (stop_hit_) {  // stop request (signal, --max-wall): state is still the last output state
-          stop_hit_ = false;
-          std::ostringstream os;
-          os << name() << ": stopped on request at t = " << tret << " (state kept at t = " << state.t << ")";
-          throw RunInterrupted(os.str());
-        }
-        fail(flag, tret);
-      }
-      t_ = tret;
-      if (!all_finite(data(y_.get()), 2 * n_ + 1)) {
-        add_counters(rep);
-        fail(IDA_SUCCESS, tret, "non-finite solution");
-      }
-      if (flag == IDA_ROOT_RETURN) {
-        ++rep.root_events;
-        read_y(work_);
-        const int switched = system.rechart(work_);
-        rep.chart_switches += switched;
-        if (switched > 0) {
-          add_counters(rep);
-          write_y(work_, data(yp_.get())[2 * n_]);
-          check(IDAReInit(mem_, t_, y_.get(), yp_.get()), "IDAReInit");
-          base_ = IdaCounters{};
-          ++rep.reinitializations;
-        }
-      }
-    }
-    add_counters(rep);
-    read_y(work_);
-    work_.t = t_out;
-    t_ = t_out;
-    state = work_;
+  void set_stop_time(double t_out) override { check(IDASetStopTime(mem_, t_out), "IDASetStopTime"); }
+  int one_step(double t_out, double& tret) override {
+    return IDASolve(mem_, t_out, &tret, y_.get(), yp_.get(), IDA_ONE_STEP);
+  }
+  StepOutcome outcome(int flag) const override {
+    return flag == IDA_ROOT_RETURN ? StepOutcome::root : flag == IDA_TSTOP_RETURN ? StepOutcome::reached : StepOutcome::step;
+  }
+  void pack(const State& s) override { write_y(s, data(yp_.get())[2 * n_]); }
+  void reinit() override { check(IDAReInit(mem_, t_, y_.get(), yp_.get()), "IDAReInit"); }
+  void unpack(State& s) override { read_y(s); }
+  bool acceleration_in_y() const override { return true; }
+  void rebase_counters() override { base_ = IdaCounters{}; }
+  long factorizations() const override { return sun_linear_solver_backend(LS_.get()).stats().factorizations; }
+  double last_step() const override {
     double h = 0;
     IDAGetLastStep(mem_, &h);
-    rep.last_dt = h;
-    rep.factorizations = sun_linear_solver_backend(LS_.get()).stats().factorizations - fact0;
-    w_out_ = w_;
-    rep.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
-    return rep;
+    return h;
   }
+  const double* y() const override { return N_VGetArrayPointer(y_.get()); }
 
- private:
   // --- state <-> (y, ẏ) ---
   void write_y(const State& s, double wdot = 0.0) {
     double* y = data(y_.get());
@@ -207,20 +118,6 @@ class IdaBdf final : public Integrator {
     w_ = y[2 * n_];
   }
 
-  // The caller may have re-charted or replaced the state between calls (a driver that re-charts
-  // fixed-step schemes between steps): re-initialize from it in that case.
-  bool in_sync(const State& s) const { return state_in_sync(s, t_, work_, data(y_.get()), n_); }
-  void restart_from(State& s, StepReport& rep) {
-    add_counters(rep);
-    t_ = s.t;
-    fos_->acceleration(s.t, s, s.a);
-    work_ = s;
-    write_y(s, data(yp_.get())[2 * n_]);
-    check(IDAReInit(mem_, t_, y_.get(), yp_.get()), "IDAReInit");
-    base_ = IdaCounters{};
-    ++rep.reinitializations;
-  }
-
   // --- statistics ---
   IdaCounters counters() const {
     IdaCounters c;
@@ -232,7 +129,7 @@ class IdaBdf final : public Integrator {
     IDAGetNumLinSolvSetups(mem_, &c.setups);
     return c;
   }
-  void add_counters(StepReport& rep) {
+  void add_counters(StepReport& rep) override {
     const IdaCounters c = counters();
     rep.steps += c.steps - base_.steps;
     rep.rhs_evaluations += c.residuals - base_.residuals;
@@ -242,7 +139,7 @@ class IdaBdf final : public Integrator {
     base_ = c;
   }
 
-  [[noreturn]] void fail(int flag, double t, const std::string& what = "") {
+  [[noreturn]] void fail(int flag, double t, const std::string& what) override {
     double h = 0;
     IDAGetCurrentStep(mem_, &h);
     std::ostringstream os;
@@ -318,10 +215,6 @@ class IdaBdf final : public Integrator {
   // --- C callbacks: no exception crosses them ---
   static int residual(sunrealtype t, N_Vector y, N_Vector yp, N_Vector r, void* ud) {
     auto* self = static_cast<IdaBdf*>(ud);
-    if (self->stop_requested()) {  // signal or --max-wall: abandon the interval (unrecoverable for IDA)
-      self->stop_hit_ = true;
-      return -1;
-    }
     try {
       const Index n = self->n_;
       const double* yv = N_VGetArrayPointer(y);
@@ -395,8 +288,7 @@ class IdaBdf final : public Integrator {
   static int root(sunrealtype, N_Vector y, N_Vector, sunrealtype* g, void* ud) {
     auto* self = static_cast<IdaBdf*>(ud);
     try {
-      self->fos_->unpack(N_VGetArrayPointer(y), self->work_);
-      g[0] = self->sys_->chart_margin(self->work_) + self->chart_overshoot_;
+      g[0] = self->chart_root(N_VGetArrayPointer(y));
       return 0;
     } catch (...) {
       self->errors_.capture("ida-bdf chart-margin root function");
@@ -405,30 +297,19 @@ class IdaBdf final : public Integrator {
   }
 
   // settings
-  double rtol_, atol_, max_step_, init_step_, max_steps_, chart_overshoot_;
   int max_order_;
-  std::string linear_solver_, jacobian_, mass_solver_;
-  std::vector<std::pair<std::string, std::string>> resolved_;
+  double dcj_lsetup_;
+  std::string linear_solver_, jacobian_;
 
-  // run objects (ctx_ first: freed last)
-  std::unique_ptr<SunContext> ctx_;
-  NVectorPtr y_, yp_, id_, atol_v_;
+  // run objects
+  NVectorPtr y_, yp_, id_;
   SunMatrixPtr J_;
   SunLinearSolverPtr LS_;
   void* mem_ = nullptr;
 
-  SemiDiscreteSystem* sys_ = nullptr;
-  std::unique_ptr<FirstOrderSystem> fos_;
-  Index n_ = 0;
-  State work_;  // current charts; u, v, a are scratch inside callbacks
-  double t_ = 0.0, w_ = 0.0;
-  double w_out_ = 0.0;      // W_ext at the end of the last advance() (checkpoints)
-  bool stop_hit_ = false;   // a callback saw stop_requested()
   Eigen::VectorXd a_, r_, fext_;
   SparseMatrix K_, M_, G_v_, big_;
   IdaCounters base_;
-  CallbackError errors_;
-  std::string sundials_message_;
 };
 
 }  // namespace

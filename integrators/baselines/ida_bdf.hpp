@@ -26,17 +26,21 @@
 // factorization (exact; no IDACalcIC Newton solve). After a chart switch the Model converts (q, v, v̇)
 // exactly, so IDAReInit gets a consistent (y, ẏ) again.
 //
-// Director charts (docs/theory.md §2.3): root function g = chart_margin(state(y)), direction −1
-// (margin going negative), shifted by chart_overshoot δ: g = margin + δ, so the event fires when a director
-// has turned slightly past the diagonal and every node already past it switches in the same event (nodes
-// with nearly equal directors would otherwise trigger one event and one restart each); at a root the state is written back, system.rechart() switches charts and
-// IDA is re-initialized from the converted (y, ẏ). StepReport counts root events, switches and
-// re-initializations.
+// Director charts (docs/theory.md §2.3), tolerances, progress output and the evolve / root-event / re-init
+// loop: shared with the ARKODE baselines (integrators/baselines/sundials_baseline.hpp). The chart-margin root
+// is shifted by chart_overshoot δ (g = margin + δ), so the event fires when a director has turned slightly
+// past the diagonal and every node already past it switches in the same event. After a switch the Model
+// converts (q, v, v̇) exactly, so IDAReInit gets a consistent (y, ẏ) again.
 //
-// Settings: rtol [1e-6]; atol [1e-9] (scaled per block, FirstOrderSystem::absolute_tolerances);
-// max_order [5]; max_step [0 = none]; init_step [0 = IDA's choice]; linear_solver [klu];
-// jacobian: approximate|fd-inertia [approximate]; mass_solver: eigen-ldlt|cholmod [eigen-ldlt]
-// (initial acceleration); max_steps [1e8] (internal steps per advance() call); chart_overshoot [0.05].
+// Tuning (docs/results.md, "Baseline tuning"): max_order 2 by default. The semi-discrete shell is undamped:
+// its stiff modes have eigenvalues near the imaginary axis, where BDF3–5 are not stable (they are only
+// A(α)-stable); with orders > 2 IDA must resolve every stiff vibration to stay stable, with BDF2 (A-stable) it
+// steps over them. The Newton matrix is re-evaluated only when IDA asks (failed convergence, or c_j
+// changed by more than delta_cj_lsetup, default 0.25 as in IDA).
+//
+// Settings (plus the common ones of sundials_baseline.hpp: rtol, atol, length_scale, time_scale, max_step,
+// init_step, max_steps, chart_overshoot, mass_solver (initial acceleration), mass_reuse, progress_every):
+// max_order [2]; linear_solver [klu]; jacobian: approximate|fd-inertia [approximate]; delta_cj_lsetup [0.25].
 #pragma once
 
 #include "integrators/integrator.hpp"

@@ -15,6 +15,7 @@
 #include <cmath>
 #include <csignal>
 #include <cstdio>
+#include <ctime>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -54,6 +55,14 @@ void fill_summary_json(JsonFields& j, const RunSummary& s) {
   j.set("max_strain_over_energy", s.max_strain_ratio);
   for (const auto& [name, value] : s.final_monitors) j.set("final_" + name, value);
   j.set("wall_s", s.wall_seconds);
+  j.set("cpu_s", s.cpu_seconds);
+}
+
+// CPU seconds of this thread (single-threaded runs: several may share the process) or of the process.
+double cpu_now(bool thread_only) {
+  timespec ts{};
+  clock_gettime(thread_only ? CLOCK_THREAD_CPUTIME_ID : CLOCK_PROCESS_CPUTIME_ID, &ts);
+  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
 }
 
 // --- signals ---------------------------------------------------------------------------------------
@@ -230,6 +239,8 @@ RunSummary run_dynamic(Problem& problem, const RunOptions& o) {
   CaseSpec& spec = problem.spec;
   Model& model = *problem.model;
   if (o.threads > 0) omp_set_num_threads(o.threads);
+  const bool thread_cpu = omp_get_max_threads() == 1;
+  const double cpu0 = cpu_now(thread_cpu);
   const Checkpoint* resume = o.resume;
   const std::string case_text = resume ? resume->text("case_text") : read_file(spec.source);
   const std::string mesh_hash =
@@ -301,19 +312,24 @@ RunSummary run_dynamic(Problem& problem, const RunOptions& o) {
 
   // --- state and reference quantities ----------------------------------------------------------------
   State state = problem.initial_state();
+  // Progress (docs/manual.md §1): one line updated in place on a terminal (every 0.2 s of wall time);
+  // otherwise a plain line at every 10 % of the simulated time. Adaptive integrators add lines inside
+  // long output intervals (in place on a terminal as well).
+  const bool tty = o.log && ((o.log == &std::cout && isatty(STDOUT_FILENO)) || (o.log == &std::cerr && isatty(STDERR_FILENO)));
+  integrator->set_progress_log(o.log, o.label.empty() ? sum.integrator : o.label, tty);
   integrator->initialize(model, state);
+  // Integrators may resolve settings at initialize() (e.g. the baselines' absolute tolerances): report those.
+  sum.settings = integrator->settings();
+  spec.integrator.settings = sum.settings;
   const double loads_end = model.loads_end();
   bool have_ref = false;
   Eigen::Vector3d L_ref = Eigen::Vector3d::Zero(), J_ref = Eigen::Vector3d::Zero();
   double last_print = -1.0;
   long long out_index = 0, k_next = 1;
-  // Progress (docs/manual.md §1): one line updated in place on a terminal (every 0.2 s of wall time);
-  // otherwise a plain line at every 10 % of the simulated time.
-  const bool tty = o.log && ((o.log == &std::cout && isatty(STDOUT_FILENO)) || (o.log == &std::cerr && isatty(STDERR_FILENO)));
   bool line_open = false;
   double next_plain_t = 0.0;
   double E_seen = 0.0;  // largest K + V or |W_ext| so far: the scale of the energy balance while loads act
-  double wall_before = 0.0;  // wall time of the run before its last resume
+  double wall_before = 0.0, cpu_before = 0.0;  // wall and CPU time of the run before its last resume
   const long long n_out = static_cast<long long>(std::ceil(t_end / out_dt - 1e-9));
   if (resume) {
     if (resume->integrator != integrator->name())
@@ -327,6 +343,7 @@ RunSummary run_dynamic(Problem& problem, const RunOptions& o) {
     L_ref = resume->vector("L_ref");
     J_ref = resume->vector("J_ref");
     wall_before = resume->number("wall_s");
+    cpu_before = resume->numbers.count("cpu_s") ? resume->number("cpu_s") : 0.0;
     if (pvd) {
       const Eigen::VectorXd& times = resume->vector("pvd_times");
       std::istringstream files_in(resume->text("pvd_files"));
@@ -337,6 +354,7 @@ RunSummary run_dynamic(Problem& problem, const RunOptions& o) {
     }
   }
   auto elapsed = [&] { return wall_before + std::chrono::duration<double>(Clock::now() - start).count(); };
+  auto cpu_used = [&] { return cpu_before + cpu_now(thread_cpu) - cpu0; };
 
   // Checkpoints: is the integrator able to? (An explicit request must not be silently dropped.)
   const CheckpointPolicy policy = files ? o.checkpoint : CheckpointPolicy{};
@@ -364,6 +382,7 @@ RunSummary run_dynamic(Problem& problem, const RunOptions& o) {
     c.vectors["L_ref"] = L_ref;
     c.vectors["J_ref"] = J_ref;
     c.numbers["wall_s"] = elapsed();
+    c.numbers["cpu_s"] = cpu_used();
     c.numbers["history_bytes"] = history ? static_cast<double>(history->bytes()) : 0.0;
     std::string pvd_files;
     Eigen::VectorXd pvd_times(pvd ? static_cast<Eigen::Index>(pvd->entries().size()) : 0);
@@ -495,6 +514,7 @@ RunSummary run_dynamic(Problem& problem, const RunOptions& o) {
   auto write_status = [&](const std::string& status) -> std::string {
     sum.status = status;
     sum.wall_seconds = elapsed();
+    sum.cpu_seconds = cpu_used();
     if (!files) return {};
     info.status = status;
     fill_summary_json(info.summary, sum);
@@ -612,6 +632,7 @@ void print_run_summary(std::ostream& out, const RunSummary& s) {
   line("max |J - J_ref| after loads", num(s.max_dJ) + " (|J_ref| = " + num(s.ref_J) + ")");
   for (const auto& [name, value] : s.final_monitors) line("final " + name, num(value));
   line("wall time [s]", num(s.wall_seconds));
+  line("CPU time [s]", num(s.cpu_seconds));
 }
 
 }  // namespace shelldyn

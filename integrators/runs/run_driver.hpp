@@ -117,6 +117,9 @@ struct RunSummary {
   double max_strain_ratio = 0.0;   // max V/(K+V) (rigid-body checks)
   std::vector<std::pair<std::string, double>> final_monitors;
   double wall_seconds = 0.0;
+  // CPU seconds of the run: the calling thread's when the run is single-threaded (as every run of
+  // `shelldyn compare`/`study` with 2 jobs), else the whole process's. run.json: cpu_s.
+  double cpu_seconds = 0.0;
 };
 
 RunSummary run_dynamic(Problem& problem, const RunOptions& options);

@@ -1,0 +1,425 @@
+#include "integrators/runs/study.hpp"
+#include "integrators/runs/registry.hpp"
+
+#include "lib/problem.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <map>
+#include <sstream>
+#include <stdexcept>
+
+namespace fs = std::filesystem;
+
+namespace shelldyn {
+namespace {
+
+const double NaN = std::numeric_limits<double>::quiet_NaN();
+
+std::string num(double x) {
+  if (std::isnan(x)) return "nan";
+  char b[40];
+  std::snprintf(b, sizeof b, "%.6g", x);
+  return b;
+}
+
+std::string sci(double x) {
+  if (std::isnan(x)) return "n/a";
+  char b[40];
+  std::snprintf(b, sizeof b, "%.2e", x);
+  return b;
+}
+
+std::string full(double x) {
+  if (std::isnan(x)) return "nan";
+  char b[40];
+  std::snprintf(b, sizeof b, "%.17g", x);
+  return b;
+}
+
+std::string read_text(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) return "";
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+// max over the output times both tables share of ‖m(t) − m_ref(t)‖₂ (monitor columns); NaN if none shared.
+double monitor_distance(const CsvTable& a, const CsvTable& b, const std::vector<std::string>& monitors) {
+  const auto* ta = a.column("t");
+  const auto* tb = b.column("t");
+  if (!ta || !tb || monitors.empty()) return NaN;
+  std::vector<const std::vector<double>*> ca, cb;
+  for (const auto& m : monitors) {
+    ca.push_back(a.column(m));
+    cb.push_back(b.column(m));
+    if (!ca.back() || !cb.back()) return NaN;
+  }
+  double worst = -1.0;
+  size_t j = 0;
+  for (size_t i = 0; i < ta->size(); ++i) {
+    const double t = (*ta)[i], tol = 1e-9 * std::max(1.0, std::abs(t));
+    while (j < tb->size() && (*tb)[j] < t - tol) ++j;
+    if (j == tb->size()) break;
+    if (std::abs((*tb)[j] - t) > tol) continue;
+    double d2 = 0.0;
+    for (size_t k = 0; k < monitors.size(); ++k) d2 += std::pow((*ca[k])[i] - (*cb[k])[j], 2);
+    worst = std::max(worst, std::sqrt(d2));
+  }
+  return worst < 0.0 ? NaN : worst;
+}
+
+// Energy-balance error of a history: max_t |H(t) − H(t₀)| / max_t (K + V)(t), H = K + V − W_ext. The exact
+// flow keeps H constant with the loads on as well (W_ext is the work done on the body), so this measures
+// every integrator on windows that end before the loads do.
+double energy_balance_error(const CsvTable& h) {
+  const auto *K = h.column("kinetic"), *V = h.column("strain"), *H = h.column("total");
+  if (!K || !V || !H || H->empty()) return NaN;
+  double scale = 0.0, worst = 0.0;
+  for (size_t i = 0; i < H->size(); ++i) {
+    scale = std::max(scale, (*K)[i] + (*V)[i]);
+    worst = std::max(worst, std::abs((*H)[i] - (*H)[0]));
+  }
+  return scale > 0.0 ? worst / scale : NaN;
+}
+
+struct PlannedRun {
+  std::string spec, kind, integrator;
+  double dt = 0.0, rtol = 0.0;
+};
+
+std::vector<PlannedRun> plan(const StudyPreset& p, const std::string& group) {
+  std::vector<PlannedRun> runs;
+  auto name_of = [](const std::string& spec) { return spec.substr(0, spec.find(':')); };
+  if (group == "window") {
+    if (!p.reference_spec.empty()) {
+      const CompareRun ref = parse_compare_spec(p.reference_spec);
+      runs.push_back({p.reference_spec, "reference", ref.integrator, ref.dt, 0.0});
+    }
+    // Expensive runs first, so that the two workers finish together: tight tolerances and small steps.
+    std::vector<double> rtols = p.rtols, dts = p.dts;
+    std::sort(rtols.begin(), rtols.end());
+    std::sort(dts.begin(), dts.end());
+    for (double r : rtols)
+      for (const auto& s : p.adaptive_specs) runs.push_back({s + ":rtol=" + num(r), "adaptive", name_of(s), 0.0, r});
+    for (double dt : dts)
+      for (const auto& s : p.fixed_specs) runs.push_back({s + ":dt=" + num(dt), "fixed", name_of(s), dt, 0.0});
+  } else if (group == "full") {
+    for (const auto& s : p.full_baselines) {
+      const CompareRun b = parse_compare_spec(s);
+      double rtol = 0.0;
+      for (const auto& [k, v] : b.overrides)
+        if (k == "rtol") rtol = std::stod(v);
+      runs.push_back({s, "baseline", b.integrator, 0.0, rtol});
+    }
+    for (const auto& s : p.fixed_specs)
+      runs.push_back({p.full_dt > 0.0 ? s + ":dt=" + num(p.full_dt) : s, "fixed", name_of(s), p.full_dt, 0.0});
+  } else {
+    throw std::invalid_argument("study: unknown group '" + group + "' (use window, full)");
+  }
+  return runs;
+}
+
+}  // namespace
+
+std::vector<StudyPreset> study_presets() {
+  const auto names = integrator_names();
+  const bool have_exact = std::find(names.begin(), names.end(), "em-exact") != names.end();
+  std::vector<std::string> fixed = {"em-galpha", "galpha:rho_inf=1", "galpha:rho_inf=0.8", "midpoint", "newmark"};
+  if (have_exact) fixed.insert(fixed.begin() + 1, "em-exact");
+  const std::vector<std::string> adaptive = {"ida-bdf", "arkode-dirk", "arkode-erk"};
+  std::vector<StudyPreset> out;
+  {
+    StudyPreset p;
+    p.name = "flying-plate";
+    p.case_file = "flying-plate.yaml";
+    p.window_t_end = 0.5;  // inside the load (0-5 s): the explicit baseline's stability limit sets the budget
+    p.window_output = 0.005;
+    p.fixed_specs = fixed;
+    p.dts = {4e-3, 2e-3, 1e-3, 5e-4};
+    p.adaptive_specs = adaptive;
+    p.rtols = {1e-3, 1e-4, 1e-5, 1e-6};
+    p.reference_spec = "em-galpha:dt=0.000125";
+    p.full_baselines = {"ida-bdf:rtol=0.0001:atol=1e-06"};
+    p.note = "window: the first 0.5 s of the load (hat, 0-5 s); full: the paper's 20 s at its dt = 1e-3";
+    out.push_back(p);
+  }
+  {
+    StudyPreset p;
+    p.name = "cylindrical-panel";
+    p.case_file = "cylindrical-panel.yaml";
+    p.window_t_end = 0.004;  // inside the load (0-0.02 s)
+    p.window_output = 4e-5;
+    p.fixed_specs = fixed;
+    p.dts = {4e-5, 2e-5, 1e-5, 5e-6};
+    p.adaptive_specs = adaptive;
+    p.rtols = {1e-3, 1e-4, 1e-5, 1e-6};
+    p.reference_spec = "em-galpha:dt=1.25e-06";
+    p.full_baselines = {"ida-bdf:rtol=0.0001:atol=1e-06"};
+    p.note = "window: the first 0.004 s of the load (hat, 0-0.02 s); full: 0.1 s at the case's dt = 1e-5";
+    out.push_back(p);
+  }
+  {
+    StudyPreset p;
+    p.name = "pinched-hemisphere";
+    p.case_file = "pinched-hemisphere.yaml";
+    p.window_t_end = 0.005;  // inside the pinch (0-0.03 s)
+    p.window_output = 6.25e-5;
+    p.fixed_specs = fixed;
+    p.dts = {5e-4, 2.5e-4, 1.25e-4, 6.25e-5};
+    p.adaptive_specs = adaptive;
+    p.rtols = {1e-3, 1e-4, 1e-5, 1e-6};
+    p.reference_spec = "em-galpha:dt=1.5625e-05";
+    p.full_dt = 1.25e-3;
+    p.full_output = 1.25e-3;
+    p.full_baselines = {"ida-bdf:rtol=0.0001:atol=1e-06"};
+    p.note = "window: the first 0.005 s of the pinch (0-0.03 s); full: 1.25 s at 10x the paper's dt (1.25e-3) to fit "
+             "the time budget (the paper-dt run is in docs/results.md)";
+    out.push_back(p);
+  }
+  return out;
+}
+
+StudyPreset study_preset(const std::string& name) {
+  std::string list;
+  for (const auto& p : study_presets()) {
+    if (p.name == name) return p;
+    list += (list.empty() ? "" : ", ") + p.name;
+  }
+  throw std::invalid_argument("study: unknown benchmark '" + name + "' (available: " + list + ")");
+}
+
+std::string run_json_status(const std::string& text) {
+  const std::string key = "\"status\": \"";
+  const auto p = text.find(key);
+  if (p == std::string::npos) return "";
+  const auto e = text.find('"', p + key.size());
+  return e == std::string::npos ? "" : text.substr(p + key.size(), e - p - key.size());
+}
+
+double run_json_number(const std::string& text, const std::string& key) {
+  const auto s = text.find("\"summary\"");
+  if (s == std::string::npos) return NaN;
+  const std::string k = "\"" + key + "\":";
+  const auto p = text.find(k, s);
+  if (p == std::string::npos) return NaN;
+  const char* begin = text.c_str() + p + k.size();
+  char* end = nullptr;
+  const double x = std::strtod(begin, &end);
+  return end == begin ? NaN : x;
+}
+
+StudyResult run_study(const StudyOptions& o) {
+  if (o.out_dir.empty()) throw std::invalid_argument("study: an output folder is required");
+  const StudyPreset& p = o.preset;
+  Problem first = load_problem(o.case_path);  // validates the case once, up front
+  const double loads_end = first.model->loads_end();
+  std::vector<std::string> monitors;
+  for (const auto& m : first.disc.monitors) monitors.push_back(m.name);
+  auto say = [&](const std::string& line) {
+    if (o.log) *o.log << line << std::endl;
+  };
+
+  StudyResult result;
+  std::map<std::string, std::vector<std::pair<PlannedRun, std::string>>> labelled;  // group -> (run, label)
+  for (const auto& group : o.groups) {
+    const std::vector<PlannedRun> runs = plan(p, group);
+    CompareOptions co = o.execution;
+    co.case_path = o.case_path;
+    co.dts.clear();
+    co.rtols.clear();
+    co.reference.clear();
+    co.vtu_every = 0;
+    co.t_end = group == "window" ? p.window_t_end : -1.0;
+    co.output_interval = group == "window" ? p.window_output : p.full_output;
+    co.out_dir = (fs::path(o.out_dir) / group).string();
+    co.log = o.report ? o.log : nullptr;
+    co.command = o.command;
+    for (const auto& r : runs) co.specs.push_back(r.spec);
+    const std::vector<CompareRun> expanded = expand_compare_runs(co);  // labels; bad specs fail here
+    std::vector<std::string> pending;
+    for (size_t k = 0; k < runs.size(); ++k) {
+      labelled[group].emplace_back(runs[k], expanded[k].label);
+      const std::string status = run_json_status(read_text((fs::path(co.out_dir) / expanded[k].label / "run.json").string()));
+      if (status == "complete" && !o.rerun) {
+        ++result.skipped;
+        if (o.dry_run) say("  " + group + "/" + expanded[k].label + ": complete (kept)");
+      } else {
+        pending.push_back(runs[k].spec);
+        if (o.dry_run) say("  " + group + "/" + expanded[k].label + ": to run");
+      }
+    }
+    say("study " + p.name + " / " + group + ": " + std::to_string(runs.size()) + " runs, " +
+        std::to_string(runs.size() - pending.size()) + " already complete, " + std::to_string(pending.size()) + " to run -> " +
+        co.out_dir);
+    if (o.dry_run || pending.empty()) continue;
+    co.specs = pending;
+    const CompareResult cr = run_comparison(co);
+    result.ran += static_cast<int>(cr.rows.size());
+  }
+
+  if (!o.report) return result;  // an MPI worker rank: rank 0 reports
+
+  // --- rows from the run folders (resumed runs included) -------------------------------------------------
+  std::map<std::string, CsvTable> ref_table;  // group -> reference history
+  std::string ref_label;
+  for (const auto& [group, runs] : labelled)
+    for (const auto& [run, label] : runs)
+      if (run.kind == "reference") {
+        ref_label = label;
+        try {
+          ref_table[group] = read_csv_table((fs::path(o.out_dir) / group / label / "history.csv").string());
+        } catch (const std::exception&) {
+        }
+      }
+  for (const auto& group : o.groups) {
+    for (const auto& [run, label] : labelled[group]) {
+      StudyRow row;
+      row.group = group;
+      row.label = label;
+      row.integrator = run.integrator;
+      row.kind = run.kind;
+      row.dt = run.dt;
+      row.rtol = run.rtol;
+      row.energy_error = row.energy_error_after_loads = row.displacement_error = row.max_dL = row.max_dJ = NaN;
+      const fs::path dir = fs::path(o.out_dir) / group / label;
+      const std::string json = read_text((dir / "run.json").string());
+      row.status = json.empty() ? "not run" : run_json_status(json);
+      if (row.status.rfind("incomplete", 0) == 0) row.status = "failed: " + row.status.substr(std::min<size_t>(12, row.status.size()));
+      if (row.status == "complete") {
+        row.steps = static_cast<long>(run_json_number(json, "steps"));
+        row.rhs_evaluations = static_cast<long>(run_json_number(json, "rhs_evaluations"));
+        row.factorizations = static_cast<long>(run_json_number(json, "factorizations"));
+        row.nonlinear_iterations = static_cast<long>(run_json_number(json, "nonlinear_iterations"));
+        row.cpu_s = run_json_number(json, "cpu_s");
+        row.wall_s = run_json_number(json, "wall_s");
+        row.t_end = run_json_number(json, "t_end");
+        row.max_dL = run_json_number(json, "max_abs_dL_after_loads");
+        row.max_dJ = run_json_number(json, "max_abs_dJ_after_loads");
+        row.ref_L = run_json_number(json, "norm_L_ref");
+        row.ref_J = run_json_number(json, "norm_J_ref");
+        try {
+          const CsvTable h = read_csv_table((dir / "history.csv").string());
+          row.energy_error = energy_balance_error(h);
+          row.energy_error_after_loads = mechanical_energy_drift(h, loads_end);
+          if (ref_table.count(group) && run.kind != "reference")
+            row.displacement_error = monitor_distance(h, ref_table[group], monitors);
+        } catch (const std::exception& e) {
+          row.status = std::string("failed: history unreadable: ") + e.what();
+        }
+      } else if (row.status != "not run") {
+        ++result.failed;
+      }
+      result.rows.push_back(row);
+    }
+  }
+  if (o.dry_run) return result;
+
+  // --- study.csv -------------------------------------------------------------------------------------------
+  result.study_csv = (fs::path(o.out_dir) / "study.csv").string();
+  {
+    std::ofstream csv(result.study_csv);
+    if (!csv) throw std::runtime_error(result.study_csv + ": cannot write");
+    csv << "group,label,integrator,kind,dt,rtol,t_end,steps,rhs_evaluations,factorizations,nonlinear_iterations,cpu_s,wall_s,"
+           "energy_error,energy_error_after_loads,displacement_error,max_dL,max_dJ,norm_L_ref,norm_J_ref,status\n";
+    for (const auto& r : result.rows) {
+      std::string status = r.status;
+      for (char& c : status)
+        if (c == ',' || c == '\n' || c == '"') c = ';';
+      csv << r.group << "," << r.label << "," << r.integrator << "," << r.kind << "," << full(r.dt) << "," << full(r.rtol) << ","
+          << full(r.t_end) << "," << r.steps << "," << r.rhs_evaluations << "," << r.factorizations << ","
+          << r.nonlinear_iterations << "," << full(r.cpu_s) << "," << full(r.wall_s) << "," << full(r.energy_error) << ","
+          << full(r.energy_error_after_loads) << "," << full(r.displacement_error) << "," << full(r.max_dL) << "," << full(r.max_dJ) << "," << full(r.ref_L) << ","
+          << full(r.ref_J) << "," << status << "\n";
+    }
+    if (!csv) throw std::runtime_error(result.study_csv + ": write error");
+  }
+
+  // --- study.md --------------------------------------------------------------------------------------------
+  // Reference accuracy: distance between the reference and the finest sweep run of the same integrator and
+  // settings, divided by (dt_sweep/dt_ref)^2 − 1 (second-order convergence; Richardson).
+  double ref_error = NaN;
+  {
+    const StudyRow* ref = nullptr;
+    for (const auto& r : result.rows)
+      if (r.kind == "reference" && r.status == "complete") ref = &r;
+    if (ref) {
+      const std::string prefix = ref->label.substr(0, ref->label.rfind("_dt="));
+      const StudyRow* finest = nullptr;
+      for (const auto& r : result.rows)
+        if (r.group == "window" && r.kind == "fixed" && r.status == "complete" && r.label.rfind(prefix + "_dt=", 0) == 0 &&
+            (!finest || r.dt < finest->dt))
+          finest = &r;
+      if (finest && finest->dt > ref->dt) ref_error = finest->displacement_error / (std::pow(finest->dt / ref->dt, 2) - 1.0);
+    }
+  }
+  result.study_md = (fs::path(o.out_dir) / "study.md").string();
+  {
+    std::ofstream md(result.study_md);
+    if (!md) throw std::runtime_error(result.study_md + ": cannot write");
+    md << "# Integrator study: " << p.name << "\n\n";
+    md << "- case: `" << o.case_path << "` (" << first.spec.description << ")\n";
+    md << "- command: `" << o.command << "`\n";
+    md << "- " << p.note << "\n";
+    md << "- loads end at " << num(loads_end) << " s. Energy error (energy balance): max_t |H(t) − H(0)| / max_t (K + V)(t) "
+          "with H = K + V − W_ext, which the exact flow keeps constant with or without loads; after the loads: max |H − "
+          "H_ref|/(K + V)_ref from the loads' end on (n/a when the run ends before). Displacement error: max over the output times of ‖(";
+    for (size_t k = 0; k < monitors.size(); ++k) md << (k ? ", " : "") << monitors[k];
+    md << ") − reference‖₂, reference `" << ref_label << "` (its own error, estimated by Richardson from the finest "
+       << "sweep run of the same scheme: " << sci(ref_error) << ").\n";
+    md << "- cost: CPU seconds of each run (one core each, two runs at a time) and residual / right-hand-side "
+          "evaluations.\n\n";
+    for (const auto& group : o.groups) {
+      md << "## " << (group == "window" ? "Work–precision window, t ≤ " + num(p.window_t_end) + " s" : std::string("Full duration"))
+         << "\n\n";
+      md << "| run | Δt or rtol | steps | RHS evals | factorizations | CPU [s] | energy error | after loads | displ. error | "
+            "max ‖ΔL‖ | max ‖ΔJ‖ | status |\n|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+      for (const auto& r : result.rows) {
+        if (r.group != group) continue;
+        md << "| `" << r.label << "` | " << (r.rtol > 0 ? "rtol " + num(r.rtol) : r.dt > 0 ? "Δt " + num(r.dt) : "case Δt")
+           << " | ";
+        if (r.status == "complete")
+          md << r.steps << " | " << r.rhs_evaluations << " | " << r.factorizations << " | " << num(r.cpu_s) << " | "
+             << sci(r.energy_error) << " | " << sci(r.energy_error_after_loads) << " | " << sci(r.displacement_error) << " | " << sci(r.max_dL) << " | " << sci(r.max_dJ)
+             << " | complete |\n";
+        else
+          md << "– | – | – | – | – | – | – | – | – | " << r.status << " |\n";
+      }
+      md << "\n";
+    }
+    // Headline: the cheapest energy-momentum window run against the cheapest baseline run as accurate in energy.
+    const StudyRow* em = nullptr;
+    for (const auto& r : result.rows)
+      if (r.group == "window" && r.kind == "fixed" && r.status == "complete" &&
+          (r.integrator == "em-galpha" || r.integrator == "em-exact") && (!em || r.cpu_s < em->cpu_s))
+        em = &r;
+    if (em) {
+      const StudyRow* match = nullptr;
+      const StudyRow* best = nullptr;
+      for (const auto& r : result.rows) {
+        if (r.group != "window" || r.kind != "adaptive" || r.status != "complete") continue;
+        if (r.energy_error <= em->energy_error && (!match || r.cpu_s < match->cpu_s)) match = &r;
+        if (!best || r.energy_error < best->energy_error) best = &r;
+      }
+      md << "## Headline\n\n";
+      if (match)
+        md << "`" << em->label << "` reaches energy error " << sci(em->energy_error) << " at " << num(em->cpu_s)
+           << " CPU s; the cheapest baseline run as accurate, `" << match->label << "`, needs " << num(match->cpu_s)
+           << " CPU s: " << num(match->cpu_s / em->cpu_s) << " times the cost.\n";
+      else if (best)
+        md << "`" << em->label << "` reaches energy error " << sci(em->energy_error) << " at " << num(em->cpu_s)
+           << " CPU s; no baseline run reaches that error: the most accurate, `" << best->label << "`, reaches "
+           << sci(best->energy_error) << " at " << num(best->cpu_s) << " CPU s (" << num(best->cpu_s / em->cpu_s)
+           << " times the cost, " << num(best->energy_error / std::max(em->energy_error, 1e-300)) << " times the error).\n";
+    }
+    if (!md) throw std::runtime_error(result.study_md + ": write error");
+  }
+  return result;
+}
+
+}  // namespace shelldyn

@@ -1,0 +1,97 @@
+// The integrator study behind `shelldyn study BENCHMARK` (docs/results.md, "Integrator study"): for one of the
+// paper's benchmarks, a work–precision sweep of every time integrator on a window every method can afford,
+// plus full-duration conservation runs. Built on the comparison machinery of compare.hpp: every batch of runs
+// is one run_comparison() call (same specs, labels, settings inheritance and run execution), so the study
+// runs wherever and however `shelldyn compare` runs.
+//
+// Groups (sub-folders of the study folder):
+//   window/   the work–precision sweep on [0, window_t_end] (short enough for the explicit baseline, whose
+//             stability limit does not depend on its tolerance): the fixed-step schemes over the Δt list, the adaptive SUNDIALS
+//             baselines over the rtol list, and one tight reference run (`reference`, a fixed-step scheme at
+//             a Δt well below the sweep's) for displacement errors;
+//   full/     the case's full duration: every fixed-step scheme at full_dt and the cheapest baseline.
+// Resumable: a run whose <group>/<label>/run.json says "status": "complete" is not run again (delete its
+// folder, or pass rerun, to repeat it); only the missing runs go to run_comparison().
+//
+// Measures per run (study.csv / study.md, from the run folders, so resumed runs count too):
+//   energy error  = energy balance max_t |H(t) − H(0)| / max_t (K + V)(t), H = K + V − W_ext (the exact flow keeps
+//                   H constant with the loads on too; every integrator accumulates W_ext consistently with its
+//                   own discretization); energy_error_after_loads = mechanical_energy_drift(history, loads_end)
+//                   where the run goes past the loads' end;
+//   displ. error  = max over the output times of ‖monitors(t) − monitors_ref(t)‖₂ against the window's
+//                   reference run (the reference's own error is estimated from the finest sweep run of the
+//                   same scheme, Richardson with order 2, and printed in study.md);
+//   cost          = cpu_s (CPU seconds of the run, run.json) and rhs_evaluations (residual / right-hand-side
+//                   evaluations; one per Newton iteration for the implicit schemes, one per stage for ARKODE).
+//   ΔL, ΔJ        = max ‖L − L_ref‖, ‖J − J_ref‖ after the loads (run.json).
+// Then scripts/plot_study.py draws work_precision.png, full_energy.png, full_momentum.png.
+#pragma once
+
+#include "integrators/runs/compare.hpp"
+
+#include <ostream>
+#include <string>
+#include <vector>
+
+namespace shelldyn {
+
+// One benchmark's study: which runs, on which window. Chosen so that the three benchmarks together fit in
+// 30 minutes on 2 cores (docs/results.md lists the measured times).
+struct StudyPreset {
+  std::string name;                       // flying-plate | cylindrical-panel | pinched-hemisphere
+  std::string case_file;                  // file name under apps/cases
+  double window_t_end = 0.0;              // work–precision window [0, window_t_end]
+  double window_output = 0.0;             // output interval on the window
+  std::vector<std::string> fixed_specs;   // fixed-step schemes (compare specs without dt)
+  std::vector<double> dts;                // their Δt sweep
+  std::vector<std::string> adaptive_specs;  // SUNDIALS baselines (compare specs without rtol)
+  std::vector<double> rtols;              // their rtol sweep
+  std::string reference_spec;             // tight reference on the window (a compare spec with dt)
+  double full_dt = 0.0;                   // Δt of the full-duration runs (0: the case's)
+  double full_output = 0.0;               // output interval of the full-duration runs (0: the case's)
+  std::vector<std::string> full_baselines;  // baseline specs run over the full duration
+  std::string note;                       // printed in study.md (why this window / Δt)
+};
+
+// The presets of the three benchmarks; fixed_specs includes em-exact when that integrator is registered.
+std::vector<StudyPreset> study_presets();
+// The preset called `name`; throws std::invalid_argument listing the names otherwise.
+StudyPreset study_preset(const std::string& name);
+
+struct StudyOptions {
+  StudyPreset preset;
+  std::string case_path;                  // resolved case file
+  std::string out_dir;                    // required
+  std::vector<std::string> groups = {"window", "full"};
+  bool rerun = false;                     // true: run completed runs again
+  bool dry_run = false;                   // true: list the runs (and which are done), run nothing
+  CompareOptions execution;               // jobs / threads / executor handed to run_comparison() (MPI: every rank
+                                          // calls run_study; only the one with report = true writes the tables)
+  bool report = true;
+  std::ostream* log = nullptr;
+  std::string command;
+};
+
+struct StudyRow {
+  std::string group, label, integrator, kind;  // kind: fixed | adaptive | reference | baseline
+  double dt = 0.0, rtol = 0.0;            // the swept parameter (0 where not applicable)
+  std::string status;                     // "complete", "failed: ...", "not run"
+  long steps = 0, rhs_evaluations = 0, factorizations = 0, nonlinear_iterations = 0;
+  double cpu_s = 0.0, wall_s = 0.0;
+  double energy_error = 0.0, energy_error_after_loads = 0.0, displacement_error = 0.0, max_dL = 0.0, max_dJ = 0.0, ref_L = 0.0, ref_J = 0.0;
+  double t_end = 0.0;
+};
+
+struct StudyResult {
+  std::vector<StudyRow> rows;
+  int ran = 0, skipped = 0, failed = 0;
+  std::string study_csv, study_md;
+};
+
+StudyResult run_study(const StudyOptions& options);
+
+// The value of "key" in the "summary" object of a run.json (NaN if absent), and its "status".
+double run_json_number(const std::string& run_json_text, const std::string& key);
+std::string run_json_status(const std::string& run_json_text);
+
+}  // namespace shelldyn
