@@ -124,6 +124,8 @@ int run_modes(const ModesOptions& o) {
     }
     if (!csv) throw std::runtime_error("cannot write " + dir + "/modes.csv");
   }
+  // Machine-readable shapes (every DOF kind), e.g. for initial_velocity: {mode: ..., index: k, amplitude: A}.
+  write_mode_shapes_csv(dir + "/mode_shapes.csv", model, state, r);
   if (!o.no_vtu) {
     // Scale: largest translation = 10 % of the model's largest extent, so each VTU shows the shape.
     const Mesh& mesh = model.mesh();
@@ -175,7 +177,7 @@ int run_modes(const ModesOptions& o) {
   info.summary.set("wall_s", r.total_s);
   for (size_t k = 0; k < r.modes.size(); ++k) info.summary.set("f" + std::to_string(k + 1) + "_hz", r.modes[k].frequency);
   write_run_json(dir + "/run.json", problem.spec, info);
-  std::cout << "wrote " << dir << "/modes.csv" << (o.no_vtu ? "" : ", " + dir + "/modes.pvd") << ", " << dir << "/run.json\n";
+  std::cout << "wrote " << dir << "/modes.csv, " << dir << "/mode_shapes.csv" << (o.no_vtu ? "" : ", " + dir + "/modes.pvd") << ", " << dir << "/run.json\n";
   return 0;
 }
 
@@ -185,7 +187,7 @@ void add_modes_command(CLI::App& app, std::function<int()>& action, const std::s
   auto o = std::make_shared<ModesOptions>();
   o->command = command;
   CLI::App* sub = app.add_subcommand(
-      "modes", "Natural frequencies and mode shapes (K phi = omega^2 M phi, shift-invert Lanczos); write modes.csv, modes.pvd, run.json");
+      "modes", "Natural frequencies and mode shapes (K phi = omega^2 M phi, shift-invert Lanczos); write modes.csv, mode_shapes.csv, modes.pvd, run.json");
   sub->add_option("case", o->case_path, "Case file (YAML), e.g. apps/cases/plate-modes-ss-thin.yaml")->required();
   sub->add_option("-n,--modes", o->num_modes, "Number of modes, rigid-body modes included (default 10)")->check(CLI::PositiveNumber);
   sub->add_option("--shift", o->shift_hz, "Find the modes nearest this frequency [Hz] (default 0: the lowest modes)")

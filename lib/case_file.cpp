@@ -369,11 +369,25 @@ std::vector<BoundaryConditionSpec> parse_bcs(const Parser& p, const YAML::Node& 
 
 InitialVelocitySpec parse_initial_velocity(const Parser& p, const YAML::Node& n, const std::string& path,
                                            const std::string& base_dir) {
-  p.check_keys(n, path, {"set", "translation", "angular", "about", "field"}, {});
+  p.check_keys(n, path, {"set", "translation", "angular", "about", "field", "mode", "index", "amplitude"}, {});
   InitialVelocitySpec v;
   v.given = true;
   v.where = p.where(n, path);
   if (n["set"]) v.set = p.name(n["set"], path + ".set");
+  if (n["mode"]) {  // a mode shape of `shelldyn modes` (docs/manual.md §2.6)
+    for (const char* k : {"translation", "angular", "about", "field"})
+      if (n[k]) p.fail(n[k], path + "." + k, "give either 'mode' (with index, amplitude) or '" + std::string(k) + "', not both");
+    for (const char* k : {"index", "amplitude"})
+      if (!n[k]) p.fail(n, path + "." + k, std::string("missing required key '") + k + "' (a mode needs 'index' and 'amplitude')");
+    fs::path file(p.string(n["mode"], path + ".mode"));
+    if (file.is_relative()) file = fs::path(base_dir) / file;
+    v.mode_file = file.lexically_normal().string();
+    v.mode_index = p.count(n["index"], path + ".index", 1);
+    v.mode_amplitude = p.number(n["amplitude"], path + ".amplitude");
+    return v;
+  }
+  for (const char* k : {"index", "amplitude"})
+    if (n[k]) p.fail(n[k], path + "." + k, "'" + std::string(k) + "' belongs to a mode shape: add 'mode: mode_shapes.csv' (written by shelldyn modes)");
   if (n["field"]) {
     for (const char* k : {"translation", "angular", "about"})
       if (n[k]) p.fail(n[k], path + "." + k, "give either 'field' or a rigid motion (translation/angular/about), not both");

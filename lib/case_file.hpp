@@ -25,7 +25,8 @@
 //     NAME: {point: [x,y,z], [tol]} | {box: [[xmin,ymin,zmin],[xmax,ymax,zmax]]}
 //         | {nodes: [i, ...]}  (0-based) | {union: [NAME, ...]}
 //   boundary_conditions: [{set, fix: [ux|uy|uz|px|py|pz|director, ...]}, ...]          optional
-//   initial_velocity: {[set = all], [translation], [angular], [about: centroid | [x,y,z]] | [field: v.csv]}
+//   initial_velocity: {[set = all], [translation], [angular], [about: centroid | [x,y,z]] | [field: v.csv]
+//                      | [mode: mode_shapes.csv, index: k, amplitude: A]}
 //                     or a list of such entries (later ones override earlier ones)         optional
 //   loads: [{set, type: force|moment, direction, amplitude, [distribution: per_node|edge_total|per_length],
 //            [function: {type: constant|ramp|hat|triangle|table, ...}]}
@@ -133,6 +134,11 @@ struct InitialVelocitySpec {
   bool given = false;  // false: the body starts at rest
   std::string set = "all";
   std::string field;   // absolute path of a CSV velocity field; empty: rigid field
+  // Mode shape of `shelldyn modes` (mode_shapes.csv): v = amplitude · φ_index (φ mass-normalised, so the
+  // initial kinetic energy is ½ amplitude² when the set is `all`). Empty: no mode.
+  std::string mode_file;
+  int mode_index = 0;        // 1-based, the `mode` column of modes.csv / mode_shapes.csv
+  double mode_amplitude = 0.0;
   Eigen::Vector3d translation = Eigen::Vector3d::Zero();
   Eigen::Vector3d angular = Eigen::Vector3d::Zero();
   bool about_centroid = true;  // true: about = centroid of the set's nodes

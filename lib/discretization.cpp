@@ -75,6 +75,51 @@ std::map<int, Eigen::Matrix<double, 6, 1>> read_velocity_field(const std::string
   return out;
 }
 
+// Mode `index` (1-based) of a mode-shape file written by `shelldyn modes` (mode_shapes.csv:
+// mode,node,ux,uy,uz,pdx,pdy,pdz; lib/modal_analysis.hpp), as a velocity field amplitude · φ in the format of
+// read_velocity_field. Every node of the mesh must be in the file for that mode.
+std::map<int, Eigen::Matrix<double, 6, 1>> read_mode_field(const std::string& path, int index, double amplitude,
+                                                           int num_nodes, const std::string& where) {
+  std::ifstream in(path);
+  if (!in)
+    fail(where + ".mode", "cannot open the mode-shape file '" + path +
+                              "' (write it with: shelldyn modes CASE -o DIR -> DIR/mode_shapes.csv; relative to the case file)");
+  const std::string header = "mode,node,ux,uy,uz,pdx,pdy,pdz";
+  std::string line;
+  std::getline(in, line);
+  if (!line.empty() && line.back() == '\r') line.pop_back();
+  if (line != header)
+    fail(where + ".mode", path + ":1: expected the header '" + header + "' (the mode_shapes.csv of shelldyn modes)");
+  std::map<int, Eigen::Matrix<double, 6, 1>> out;
+  long long max_mode = 0;
+  for (int lineno = 2; std::getline(in, line); ++lineno) {
+    if (line.empty() || line == "\r") continue;
+    std::replace(line.begin(), line.end(), ',', ' ');
+    std::istringstream is(line);
+    long long mode = -1, node = -1;
+    Eigen::Matrix<double, 6, 1> v;
+    is >> mode >> node >> v[0] >> v[1] >> v[2] >> v[3] >> v[4] >> v[5];
+    if (!is || mode < 1 || node < 0 || !v.allFinite())
+      fail(where + ".mode", path + ":" + std::to_string(lineno) + ": expected a mode number >= 1, a node index and 6 finite numbers");
+    if (node >= num_nodes)
+      fail(where + ".mode", path + ":" + std::to_string(lineno) + ": node " + std::to_string(node) + " is not in the mesh (" +
+                                std::to_string(num_nodes) + " nodes): mode shapes of another mesh?");
+    max_mode = std::max(max_mode, mode);
+    if (mode != index) continue;
+    if (out.count(static_cast<int>(node)))
+      fail(where + ".mode", path + ":" + std::to_string(lineno) + ": node " + std::to_string(node) + " repeated for mode " +
+                                std::to_string(index));
+    out[static_cast<int>(node)] = amplitude * v;
+  }
+  if (out.empty())
+    fail(where + ".index", "mode " + std::to_string(index) + " is not in " + path + " (it holds modes 1.." +
+                               std::to_string(max_mode) + "; compute more with shelldyn modes -n)");
+  if (static_cast<int>(out.size()) != num_nodes)
+    fail(where + ".mode", path + " gives mode " + std::to_string(index) + " at " + std::to_string(out.size()) + " nodes, the mesh has " +
+                              std::to_string(num_nodes) + " (mode shapes of another mesh?)");
+  return out;
+}
+
 // Elements a distributed load acts on: the element set `name`, else the elements whose nine nodes all
 // belong to the node set `name`.
 std::vector<int> find_elements(const Mesh& mesh, const std::string& name, const std::string& where) {
@@ -292,8 +337,12 @@ Discretization build_discretization(const CaseSpec& spec) {
     const InitialVelocitySpec& iv = *ivp;
     const std::vector<int>& nodes = find_set(mesh, iv.set, iv.where + ".set");
     double scale = 0.0;
-    if (!iv.field.empty()) {
-      for (const auto& [node, vel] : read_velocity_field(iv.field, n, iv.where + ".field")) {
+    if (!iv.field.empty() || !iv.mode_file.empty()) {
+      // A CSV field, or a mode shape of `shelldyn modes` scaled by the amplitude (same format once read).
+      const auto field = iv.mode_file.empty()
+                             ? read_velocity_field(iv.field, n, iv.where + ".field")
+                             : read_mode_field(iv.mode_file, iv.mode_index, iv.mode_amplitude, n, iv.where);
+      for (const auto& [node, vel] : field) {
         if (!std::binary_search(nodes.begin(), nodes.end(), node)) continue;
         const size_t si = static_cast<size_t>(node);
         const Eigen::Index base = static_cast<Eigen::Index>(DofMap::dof(node, 0));

@@ -1,12 +1,15 @@
 // Shift-invert Lanczos on the free-DOF blocks of K and M (see the header and docs/modal.md).
 #include "lib/modal_analysis.hpp"
 
+#include "elements/director.hpp"
 #include "lib/linear_solver.hpp"
 
 #include <Spectra/SymGEigsShiftSolver.h>
 
 #include <algorithm>
 #include <chrono>
+#include <cstdio>
+#include <fstream>
 #include <cmath>
 #include <limits>
 #include <sstream>
@@ -230,6 +233,28 @@ std::vector<double> elastic_periods(const ModalResult& r, int count) {
   for (const Mode& m : r.modes)
     if (!m.rigid && static_cast<int>(T.size()) < count) T.push_back(m.period);
   return T;
+}
+
+void write_mode_shapes_csv(const std::string& path, const Model& model, const State& state, const ModalResult& r) {
+  std::ofstream out(path);
+  if (!out) throw std::runtime_error("cannot write " + path + " (check the folder and its permissions)");
+  out << "mode,node,ux,uy,uz,pdx,pdy,pdz\n";
+  char buf[320];
+  const int nodes = model.mesh().num_nodes();
+  for (size_t k = 0; k < r.modes.size(); ++k) {
+    const Eigen::VectorXd& phi = r.modes[k].shape;
+    for (int i = 0; i < nodes; ++i) {
+      const Index base = DofMap::dof(i, 0);
+      const Eigen::Vector2d q = state.u.segment<2>(base + 3);
+      // δp = A1(q) δq: the director change of the mode (docs/theory.md §2.2), tangent to p.
+      const Eigen::Vector3d dp = director_A1(q, state.charts[static_cast<size_t>(i)]) * phi.segment<2>(base + 3);
+      std::snprintf(buf, sizeof buf, "%zu,%d,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g\n", k + 1, i, phi[base], phi[base + 1],
+                    phi[base + 2], dp.x(), dp.y(), dp.z());
+      out << buf;
+    }
+  }
+  out.flush();
+  if (!out) throw std::runtime_error("cannot write " + path + " (disk full?)");
 }
 
 }  // namespace shelldyn

@@ -84,4 +84,12 @@ ModalResult modal_analysis(const Model& model, const State& state, const ModalOp
 // Linearised periods of the elastic modes (rigid modes skipped): the first `count` of them.
 std::vector<double> elastic_periods(const ModalResult& r, int count);
 
+// Writes the mode shapes as CSV (`shelldyn modes` -> mode_shapes.csv; docs/manual.md §2.6 and §4):
+//     mode,node,ux,uy,uz,pdx,pdy,pdz
+// one row per mode (1-based, as in modes.csv) and node (0-based): the mass-normalised shape φ, its
+// translations and the director change δp = A1(q) φ_q (a 3-vector tangent to the director, independent of
+// the node's chart; docs/theory.md §2.2), all with 17 significant digits. `initial_velocity: {mode: FILE,
+// index: k, amplitude: A}` reads it back (v = A φ_k). Throws std::runtime_error if the file cannot be written.
+void write_mode_shapes_csv(const std::string& path, const Model& model, const State& state, const ModalResult& r);
+
 }  // namespace shelldyn

@@ -170,6 +170,11 @@ std::string run_json(const CaseSpec& c, const RunInfo& info) {
   Json& iv = cs["initial_velocity"];
   iv["set"] = c.initial_velocity.set;
   if (!c.initial_velocity.field.empty()) iv["field"] = c.initial_velocity.field;
+  if (!c.initial_velocity.mode_file.empty()) {
+    iv["mode"] = c.initial_velocity.mode_file;
+    iv["index"] = c.initial_velocity.mode_index;
+    iv["amplitude"] = number(c.initial_velocity.mode_amplitude);
+  }
   if (!c.initial_velocity_more.empty()) iv["further_entries"] = c.initial_velocity_more.size();
   iv["translation"] = vec3(c.initial_velocity.translation);
   iv["angular"] = vec3(c.initial_velocity.angular);

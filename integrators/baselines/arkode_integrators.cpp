@@ -77,9 +77,9 @@ class ArkodeIntegrator final : public SundialsBaseline {
   // --- SundialsBaseline hooks ---
   void create_solver(SemiDiscreteSystem& system, const State& state) override {
     free_ark();
-    const Index N = 2 * n_ + 1;
+    const Index N = fos_->size();
     y_ = make_serial_vector(N, *ctx_);
-    fos_->pack(state, w_, data(y_.get()));
+    fos_->pack(state, w_, d_, data(y_.get()));
     mem_ = implicit_ ? ARKStepCreate(nullptr, rhs, t_, y_.get(), *ctx_) : ARKStepCreate(rhs, nullptr, t_, y_.get(), *ctx_);
     check_ptr(mem_, "ARKStepCreate");
     check(ARKStepSetErrHandlerFn(mem_, record_sundials_error, &sundials_message_), "ARKStepSetErrHandlerFn");
@@ -105,7 +105,7 @@ class ArkodeIntegrator final : public SundialsBaseline {
   StepOutcome outcome(int flag) const override {
     return flag == ARK_ROOT_RETURN ? StepOutcome::root : flag == ARK_TSTOP_RETURN ? StepOutcome::reached : StepOutcome::step;
   }
-  void pack(const State& s) override { fos_->pack(s, w_, data(y_.get())); }
+  void pack(const State& s) override { fos_->pack(s, w_, d_, data(y_.get())); }
   void reinit() override {
     check(ARKStepReInit(mem_, implicit_ ? nullptr : rhs, implicit_ ? rhs : nullptr, t_, y_.get()), "ARKStepReInit");
   }
@@ -113,7 +113,8 @@ class ArkodeIntegrator final : public SundialsBaseline {
     const double* y = data(y_.get());
     fos_->unpack(y, s);
     s.t = t_;
-    w_ = y[2 * n_];
+    w_ = y[fos_->work_index()];
+    d_ = y[fos_->damping_index()];
   }
   bool acceleration_in_y() const override { return false; }
   void rebase_counters() override { base_ = ArkCounters{}; }
@@ -180,6 +181,7 @@ class ArkodeIntegrator final : public SundialsBaseline {
     rhs_.resize(n_);
     tmp_.resize(n_);
     xq_.resize(n_);
+    zc_.resize(n_);
 
     A_.reset(SUNMatNewEmpty(*ctx_));
     check_ptr(A_.get(), "SUNMatNewEmpty");
@@ -244,13 +246,15 @@ class ArkodeIntegrator final : public SundialsBaseline {
     }
   }
 
-  // Factorize S = M + γ²K with constrained rows/columns as identity (Schur complement, header).
+  // Factorize S = M + γC + γ²K with constrained rows/columns as identity (Schur complement, header;
+  // C = 0 without damping).
   static int ls_setup(SUNLinearSolver S, SUNMatrix) {
     auto* self = static_cast<ArkodeIntegrator*>(S->content);
     try {
       const double g2 = self->gamma_ * self->gamma_;
       for (size_t k = 0; k < self->S_.values.size(); ++k)
         self->S_.values[k] = self->M_.values[k] + g2 * self->K_.values[k];
+      self->sys_->add_damping_matrix(self->gamma_, self->S_);
       apply_dirichlet(self->sys_->dofs(), self->S_, nullptr, 1.0);
       self->newton_solver_->factorize(self->S_.view());
       self->gamma_factored_ = self->gamma_;
@@ -270,7 +274,9 @@ class ArkodeIntegrator final : public SundialsBaseline {
       double* xp = N_VGetArrayPointer(x);
       const DofMap& dofs = self->sys_->dofs();
       Eigen::Map<const Eigen::VectorXd> b_q(bp, n), b_v(bp + n, n);
-      // Free rows: (M_ff + γ²K_ff) x_q,f = M_ff (b_q + γ b_v)_f − γ² K_fc x_q,c.
+      // Free rows: (M_ff + γ²K_ff) x_q,f = M_ff (b_q + γ b_v)_f − γ² K_fc x_q,c. With damping the v rows
+      // M x_v + γ K x_q + γ C x_v = M b_v give, with x_v = (x_q − b_q)/γ, S = M + γC + γ²K and the extra
+      // right-hand side γ C_ff b_q,f − γ² C_fc b_v,c.
       self->bq_ = b_q + g * b_v;
       self->xq_.setZero();
       for (Index c : dofs.constrained_dofs()) {
@@ -282,12 +288,19 @@ class ArkodeIntegrator final : public SundialsBaseline {
         multiply(self->K_.view(), self->xq_.data(), self->tmp_.data());
         self->rhs_ -= g * g * self->tmp_;
       }
+      if (self->sys_->has_damping()) {
+        self->zc_ = b_q;  // b_q,f and −γ b_v,c in one vector: C (b_q,f − γ b_v,c) scaled by γ
+        for (Index c : dofs.constrained_dofs()) self->zc_[c] = -g * bp[n + c];
+        self->sys_->damping_force(self->zc_, self->tmp_.data());
+        self->rhs_ += g * self->tmp_;
+      }
       for (Index c : dofs.constrained_dofs()) self->rhs_[c] = self->xq_[c];
       self->newton_solver_->solve(self->rhs_.data(), xp);
       for (Index i = 0; i < n; ++i) xp[n + i] = (xp[i] - bp[i]) / g;
       for (Index c : dofs.constrained_dofs()) xp[n + c] = bp[n + c];
-      xp[2 * n] = bp[2 * n];
-      if (!all_finite(xp, 2 * n + 1)) return self->ls_flag_ = SUNLS_PACKAGE_FAIL_REC;
+      xp[2 * n] = bp[2 * n];          // w and d rows: identity (their coupling to v is left out; they do
+      xp[2 * n + 1] = bp[2 * n + 1];  // not feed back, so the Newton iteration still converges to them)
+      if (!all_finite(xp, 2 * n + 2)) return self->ls_flag_ = SUNLS_PACKAGE_FAIL_REC;
       return self->ls_flag_ = SUNLS_SUCCESS;
     } catch (...) {
       self->errors_.capture("arkode-dirk Newton solve");
@@ -304,10 +317,11 @@ class ArkodeIntegrator final : public SundialsBaseline {
       double* f = N_VGetArrayPointer(ydot);
       State& s = self->work_;
       self->fos_->unpack(yv, s);
-      const double power = self->fos_->acceleration(t, s, self->a_);
+      const FirstOrderSystem::Powers power = self->fos_->acceleration(t, s, self->a_);
       std::copy(yv + n, yv + 2 * n, f);
       std::copy(self->a_.data(), self->a_.data() + n, f + n);
-      f[2 * n] = power;
+      f[2 * n] = power.external;
+      f[2 * n + 1] = power.damping;  // ḋ = vᵀ C v (first_order_system.hpp)
       return 0;
     } catch (const std::domain_error& e) {
       // Non-finite stage or director overshoot (docs/theory.md §2.1 guard): adaptive steppers retry
@@ -344,7 +358,7 @@ class ArkodeIntegrator final : public SundialsBaseline {
   // Every accepted step: a non-finite state means the step was unstable (docs/dependencies.md §7 item 11).
   static int after_step(sunrealtype t, N_Vector y, void* ud) {
     auto* self = static_cast<ArkodeIntegrator*>(ud);
-    if (all_finite(N_VGetArrayPointer(y), 2 * self->n_ + 1)) return 0;
+    if (all_finite(N_VGetArrayPointer(y), self->fos_->size())) return 0;
     try {
       std::ostringstream os;
       os << "non-finite state after the step to t = " << t;
@@ -377,7 +391,7 @@ class ArkodeIntegrator final : public SundialsBaseline {
   SparseMatrix K_, M_, S_;
   double gamma_ = 0.0, gamma_factored_ = 0.0;
   int ls_flag_ = SUNLS_SUCCESS;
-  Eigen::VectorXd bq_, rhs_, tmp_, xq_;
+  Eigen::VectorXd bq_, rhs_, tmp_, xq_, zc_;
 
   ArkCounters base_;
 };

@@ -14,14 +14,15 @@
 // K(q) − K_load and M(q) when ARKODE asks for a new Jacobian (jok = false) and only records γ
 // otherwise, and the solver solves (I − γJ) x = b with the approximation
 //
-//     J ≈ [[0, I, 0]; [−M⁻¹K, 0, 0]; [0, 0, 0]]
+//     J ≈ [[0, I, 0, 0]; [−M⁻¹K, −M⁻¹C, 0, 0]; [0, 0, 0, 0]; [0, 0, 0, 0]]   (y = [q; v; w; d])
 //
 // by the Schur complement (symmetric, factorized with linear_solver: eigen-ldlt|cholmod|klu):
 //
-//     (M + γ²K) x_q = M (b_q + γ b_v),   x_v = (x_q − b_q)/γ,   x_w = b_w.
+//     (M + γC + γ²K) x_q = M (b_q + γ b_v) + γ C b_q,   x_v = (x_q − b_q)/γ,   x_w = b_w,   x_d = b_d,
 //
-// Omitted from J (they slow Newton, they do not change the solution): −M⁻¹ ∂F_m/∂v (~|ω|),
-// −∂(M⁻¹)/∂q (...) (~ω²), and the w-row couplings. Constrained DOFs: x_v,c = b_v,c,
+// C the Rayleigh damping matrix (docs/theory.md §8.5; 0 without damping). Omitted from J (they slow Newton,
+// they do not change the solution): the rest of −M⁻¹ ∂F_m/∂v (~|ω|), −∂(M⁻¹)/∂q (...) (~ω²), and the w- and
+// d-row couplings. Constrained DOFs: x_v,c = b_v,c,
 // x_q,c = b_q,c + γ b_v,c, with the K_fc x_q,c coupling moved to the right-hand side.
 //
 // Step control: adaptive (rtol, atol) by default; `fixed_step: true` takes steps of the case's dt

@@ -28,10 +28,18 @@ FirstOrderSystem::FirstOrderSystem(SemiDiscreteSystem& system, const std::string
   corr_.resize(n_);
 }
 
-void FirstOrderSystem::pack(const State& s, double w, double* y) const {
+void FirstOrderSystem::pack(const State& s, double w, double d, double* y) const {
   std::copy(s.u.data(), s.u.data() + n_, y);
   std::copy(s.v.data(), s.v.data() + n_, y + n_);
-  y[2 * n_] = w;
+  y[work_index()] = w;
+  y[damping_index()] = d;
+}
+
+double FirstOrderSystem::damping_power(const Eigen::VectorXd& v) {
+  if (!system_->has_damping()) return 0.0;
+  cv_.resize(n_);
+  system_->damping_force(v, cv_.data());  // C v (docs/theory.md §8.5)
+  return v.dot(cv_);
 }
 
 void FirstOrderSystem::unpack(const double* y, State& s) const {
@@ -39,7 +47,7 @@ void FirstOrderSystem::unpack(const double* y, State& s) const {
   s.v = Eigen::Map<const Eigen::VectorXd>(y + n_, n_);
 }
 
-double FirstOrderSystem::acceleration(double t, const State& s, Eigen::VectorXd& a) {
+FirstOrderSystem::Powers FirstOrderSystem::acceleration(double t, const State& s, Eigen::VectorXd& a) {
   if (!all_finite(s.u.data(), n_) || !all_finite(s.v.data(), n_)) {
     std::ostringstream os;
     os << "non-finite state at t = " << t;
@@ -55,7 +63,7 @@ double FirstOrderSystem::acceleration(double t, const State& s, Eigen::VectorXd&
   // since a_c = 0 the dropped columns M_fc a_c contribute nothing (exact, not an approximation).
   apply_dirichlet(sys.dofs(), M_, rhs_.data(), 1.0);
   solve_mass(a);
-  return f_ext_.dot(s.v);
+  return {f_ext_.dot(s.v), damping_power(s.v)};
 }
 
 void FirstOrderSystem::solve_mass(Eigen::VectorXd& a) {
@@ -80,8 +88,8 @@ void FirstOrderSystem::solve_mass(Eigen::VectorXd& a) {
   mass_solver_->solve(rhs_.data(), a.data());
 }
 
-double FirstOrderSystem::momentum_residual(double t, const State& s, const Eigen::VectorXd& a,
-                                           Eigen::VectorXd& r) {
+FirstOrderSystem::Powers FirstOrderSystem::momentum_residual(double t, const State& s, const Eigen::VectorXd& a,
+                                                             Eigen::VectorXd& r) {
   const SemiDiscreteSystem& sys = *system_;
   sys.internal(s.u, s.charts, f_int_.data(), nullptr);
   sys.inertial(s.u, s.v, s.charts, f_m_.data());
@@ -91,7 +99,7 @@ double FirstOrderSystem::momentum_residual(double t, const State& s, const Eigen
   multiply(M_.view(), a.data(), r.data());
   r += f_m_ + f_int_ - f_ext_;
   for (Index c : sys.dofs().constrained_dofs()) r[c] = a[c];  // v̇_c = 0 replaces the momentum row
-  return f_ext_.dot(s.v);
+  return {f_ext_.dot(s.v), damping_power(s.v)};
 }
 
 FirstOrderSystem::ToleranceScales FirstOrderSystem::tolerance_scales(const State& s0, double length_scale,
@@ -143,7 +151,8 @@ void FirstOrderSystem::absolute_tolerances(const ToleranceScales& sc, double ato
     out[i] = atol * (translation ? sc.length : 1.0);
     out[n_ + i] = atol * (translation ? sc.velocity : 1.0 / sc.time);
   }
-  out[2 * n_] = atol * sc.energy;
+  out[work_index()] = atol * sc.energy;
+  out[damping_index()] = atol * sc.energy;  // W_damp is bounded by the energy put in, like W_ext
 }
 
 bool all_finite(const double* x, Index n) {

@@ -47,12 +47,13 @@ class IdaBdf final : public SundialsBaseline {
   // --- SundialsBaseline hooks ---
   void create_solver(SemiDiscreteSystem& system, const State& state) override {
     free_ida();
-    const Index N = 2 * n_ + 1;
+    const Index N = fos_->size();
     build_block_pattern(*system.pattern());
     K_.pattern = M_.pattern = G_v_.pattern = system.pattern();
     K_.values.assign(static_cast<size_t>(system.pattern()->nnz()), 0.0);
     M_.values = G_v_.values = K_.values;
     fext_.resize(n_);
+    cv_.resize(n_);
     y_ = make_serial_vector(N, *ctx_);
     yp_ = make_serial_vector(N, *ctx_);
     id_ = make_serial_vector(N, *ctx_);
@@ -88,7 +89,7 @@ class IdaBdf final : public SundialsBaseline {
   StepOutcome outcome(int flag) const override {
     return flag == IDA_ROOT_RETURN ? StepOutcome::root : flag == IDA_TSTOP_RETURN ? StepOutcome::reached : StepOutcome::step;
   }
-  void pack(const State& s) override { write_y(s, data(yp_.get())[2 * n_]); }
+  void pack(const State& s) override { write_y(s, data(yp_.get())[fos_->work_index()]); }
   void reinit() override { check(IDAReInit(mem_, t_, y_.get(), yp_.get()), "IDAReInit"); }
   void unpack(State& s) override { read_y(s); }
   bool acceleration_in_y() const override { return true; }
@@ -105,17 +106,19 @@ class IdaBdf final : public SundialsBaseline {
   void write_y(const State& s, double wdot = 0.0) {
     double* y = data(y_.get());
     double* yp = data(yp_.get());
-    fos_->pack(s, w_, y);
+    fos_->pack(s, w_, d_, y);
     std::copy(s.v.data(), s.v.data() + n_, yp);
     std::copy(s.a.data(), s.a.data() + n_, yp + n_);
-    yp[2 * n_] = wdot;
+    yp[fos_->work_index()] = wdot;
+    yp[fos_->damping_index()] = fos_->damping_power(s.v);  // ḋ = vᵀ C v: consistent from the start
   }
   void read_y(State& s) {
     const double* y = data(y_.get());
     fos_->unpack(y, s);
     s.a = Eigen::Map<const Eigen::VectorXd>(data(yp_.get()) + n_, n_);
     s.t = t_;
-    w_ = y[2 * n_];
+    w_ = y[fos_->work_index()];
+    d_ = y[fos_->damping_index()];
   }
 
   // --- statistics ---
@@ -160,10 +163,10 @@ class IdaBdf final : public SundialsBaseline {
     mem_ = nullptr;
   }
 
-  // --- Jacobian pattern: columns [q (n) | v (n) | w (1)], rows likewise ---
+  // --- Jacobian pattern: columns [q (n) | v (n) | w (1) | d (1)], rows likewise ---
   void build_block_pattern(const SparsePattern& P) {
     auto big = std::make_shared<SparsePattern>();
-    const Index n = P.n, N = 2 * n + 1;
+    const Index n = P.n, N = 2 * n + 2;
     big->n = N;
     big->colptr.reserve(static_cast<size_t>(N) + 1);
     big->colptr.push_back(0);
@@ -173,13 +176,16 @@ class IdaBdf final : public SundialsBaseline {
       for (Index k = P.colptr[j]; k < P.colptr[j + 1]; ++k) rows.push_back(n + P.rowind[k]);
       big->colptr.push_back(static_cast<Index>(rows.size()));
     }
-    for (Index j = 0; j < n; ++j) {  // v columns: (j, n+j) = −1, the M rows, then the w row
+    for (Index j = 0; j < n; ++j) {  // v columns: (j, n+j) = −1, the M rows, then the w and d rows
       rows.push_back(j);
       for (Index k = P.colptr[j]; k < P.colptr[j + 1]; ++k) rows.push_back(n + P.rowind[k]);
       rows.push_back(2 * n);
+      rows.push_back(2 * n + 1);
       big->colptr.push_back(static_cast<Index>(rows.size()));
     }
-    rows.push_back(2 * n);
+    rows.push_back(2 * n);  // w column
+    big->colptr.push_back(static_cast<Index>(rows.size()));
+    rows.push_back(2 * n + 1);  // d column
     big->colptr.push_back(static_cast<Index>(rows.size()));
     big_.pattern = big;
     big_.values.assign(rows.size(), 0.0);
@@ -223,11 +229,12 @@ class IdaBdf final : public SundialsBaseline {
       State& s = self->work_;
       self->fos_->unpack(yv, s);
       self->a_ = Eigen::Map<const Eigen::VectorXd>(ypv + n, n);
-      if (!all_finite(yv, 2 * n + 1) || !all_finite(ypv, 2 * n + 1)) return 1;  // recoverable: cut the step
-      const double power = self->fos_->momentum_residual(t, s, self->a_, self->r_);
+      if (!all_finite(yv, 2 * n + 2) || !all_finite(ypv, 2 * n + 2)) return 1;  // recoverable: cut the step
+      const FirstOrderSystem::Powers power = self->fos_->momentum_residual(t, s, self->a_, self->r_);
       for (Index i = 0; i < n; ++i) rv[i] = ypv[i] - yv[n + i];
       std::copy(self->r_.data(), self->r_.data() + n, rv + n);
-      rv[2 * n] = ypv[2 * n] - power;
+      rv[2 * n] = ypv[2 * n] - power.external;
+      rv[2 * n + 1] = ypv[2 * n + 1] - power.damping;  // ḋ = vᵀ C v (first_order_system.hpp)
       return 0;
     } catch (const std::domain_error&) {
       return 1;  // director overshoot (docs/theory.md §2.1 guard) or non-finite: IDA cuts the step
@@ -252,7 +259,16 @@ class IdaBdf final : public SundialsBaseline {
       sys.mass(s.u, s.charts, self->M_);
       sys.external(t, s.u, s.charts, self->fext_.data());
       self->G_v_.set_zero();
-      if (self->jacobian_ == "fd-inertia") self->add_fd_inertia(s, self->a_);
+      // ∂F_m/∂v: the damping matrix C (docs/theory.md §8.5) in the approximate Jacobian; fd-inertia
+      // differentiates F_m, which contains C v, so it has C already.
+      if (self->jacobian_ == "fd-inertia")
+        self->add_fd_inertia(s, self->a_);
+      else
+        sys.add_damping_matrix(1.0, self->G_v_);
+      if (sys.has_damping())
+        sys.damping_force(s.v, self->cv_.data());
+      else
+        self->cv_.setZero();
 
       const SparsePattern& P = *self->K_.pattern;
       const DofMap& dofs = sys.dofs();
@@ -272,9 +288,11 @@ class IdaBdf final : public SundialsBaseline {
             val[pv] = cj * self->M_.values[k] + self->G_v_.values[k];
           }
         }
-        val[pv] = -self->fext_[j];  // ∂(ẇ − F_ext·v)/∂v_j
+        val[pv++] = -self->fext_[j];         // ∂(ẇ − F_ext·v)/∂v_j
+        val[pv] = -2.0 * self->cv_[j];       // ∂(ḋ − vᵀ C v)/∂v_j (C symmetric)
       }
       val[bcol[2 * n]] = cj;
+      val[bcol[2 * n + 1]] = cj;
       copy_to_sun_matrix(self->big_, J);  // IDA zeroed J, structure included (docs/dependencies.md §3.2)
       return 0;
     } catch (const std::domain_error&) {
@@ -307,7 +325,7 @@ class IdaBdf final : public SundialsBaseline {
   SunLinearSolverPtr LS_;
   void* mem_ = nullptr;
 
-  Eigen::VectorXd a_, r_, fext_;
+  Eigen::VectorXd a_, r_, fext_, cv_;
   SparseMatrix K_, M_, G_v_, big_;
   IdaCounters base_;
 };

@@ -1,20 +1,22 @@
 // `ida-bdf`: SUNDIALS IDA (variable-order, variable-step BDF) on the residual form of the shell
-// semi-discretization (integrators/baselines/first_order_system.hpp), y = [q; v; w]:
+// semi-discretization (integrators/baselines/first_order_system.hpp), y = [q; v; w; d]:
 //
-//     F(t, y, ẏ) = [ q̇ − v ;  M(q) v̇ + F_m(q, v) + F_int(q) − F_ext(t, q) ;  ẇ − F_ext·v ]
+//     F(t, y, ẏ) = [ q̇ − v ;  M(q) v̇ + F_m(q, v) + F_int(q) − F_ext(t, q) ;  ẇ − F_ext·v ;  ḋ − vᵀC v ]
 //
+// (F_m contains the Rayleigh damping force C v of a damped model, docs/theory.md §8.5; d = W_damp.)
 // M(q) is handled exactly (ARKStep cannot: docs/dependencies.md §4.5). Constrained DOFs c keep q̇_c − v_c = 0 and
 // replace their momentum row by v̇_c = 0, so every component is differential (IDASetId all ones).
 //
-// Newton matrix ∂F/∂y + c_j ∂F/∂ẏ on a block CSC pattern built once from pattern() (2n + 1 unknowns):
+// Newton matrix ∂F/∂y + c_j ∂F/∂ẏ on a block CSC pattern built once from pattern() (2n + 2 unknowns):
 //
-//     [ c_j I                      −I                 0   ]
-//     [ K − K_load  (+ G_q)        c_j M  (+ G_v)      0   ]      constrained momentum rows: c_j e_cᵀ
-//     [ 0                          −F_extᵀ            c_j ]
+//     [ c_j I                      −I                   0     0  ]
+//     [ K − K_load  (+ G_q)        c_j M + C  (+ G_v)    0     0  ]      constrained momentum rows: c_j e_cᵀ
+//     [ 0                          −F_extᵀ              c_j   0  ]
+//     [ 0                          −2 (C v)ᵀ            0     c_j ]
 //
 // with K the exact tangent of F_int and K_load the symmetric load stiffness (add_load_stiffness).
 // What is NOT in the default ("approximate") Jacobian: G_q = ∂(M(q) v̇ + F_m(q, v))/∂q and
-// G_v = ∂F_m/∂v (the Model provides no derivatives of its inertia terms), and ∂(F_ext·v)/∂q.
+// G_v = ∂F_m/∂v − C (the Model provides no derivatives of its inertia terms), and ∂(F_ext·v)/∂q.
 // These terms scale like |ω|·c_j M and ω²M against c_j M and K, so omitting them slows Newton (more
 // iterations) but does not change the solution. `jacobian: fd-inertia` adds G_q and G_v by forward
 // differences of the Model's mass()/inertial() (2n evaluations per Jacobian: for measurements only;

@@ -61,7 +61,7 @@ void SundialsBaseline::initialize(SemiDiscreteSystem& system, State& state) {
   // A director past its chart's margin at the start: switch first (docs/theory.md §2.3).
   if (system.chart_margin(state) < 0.0) system.rechart(state);
   fos_->acceleration(state.t, state, state.a);
-  w_ = w_out_ = 0.0;
+  w_ = w_out_ = d_ = d_out_ = 0.0;
   t_ = state.t;
   work_ = state;
 
@@ -71,7 +71,7 @@ void SundialsBaseline::initialize(SemiDiscreteSystem& system, State& state) {
   const double tau = time_scale_ > 0.0 ? time_scale_ : 1.0;
   const FirstOrderSystem::ToleranceScales sc = fos_->tolerance_scales(state, length_scale_, tau);
   const double atol = atol_ > 0.0 ? atol_ : rtol_ / 1000.0;
-  atol_v_ = make_serial_vector(2 * n_ + 1, *ctx_);
+  atol_v_ = make_serial_vector(fos_->size(), *ctx_);
   fos_->absolute_tolerances(sc, atol, data(atol_v_.get()));
   tolerance_report_ = {{"length_scale", num(sc.length)},
                        {"time_scale", num(sc.time)},
@@ -87,12 +87,14 @@ void SundialsBaseline::initialize(SemiDiscreteSystem& system, State& state) {
 void SundialsBaseline::save(IntegratorCheckpoint& c) const {
   c.exact = false;
   c.scalars["W_ext"] = w_out_;
+  c.scalars["W_damp"] = d_out_;
 }
 
 void SundialsBaseline::restore(SemiDiscreteSystem& system, State& state, const IntegratorCheckpoint& c) {
   if (!fos_) throw std::logic_error(name_ + ": restore() before initialize()");
   sys_ = &system;
   w_ = w_out_ = c.scalar("W_ext");
+  d_ = d_out_ = c.scalars.count("W_damp") ? c.scalar("W_damp") : 0.0;  // checkpoints before W_damp: undamped
   StepReport ignored;
   restart_from(state, ignored);
 }
@@ -147,7 +149,7 @@ StepReport SundialsBaseline::advance(SemiDiscreteSystem& system, State& state, d
       fail(flag, tret, "");
     }
     t_ = tret;
-    if (!all_finite(y(), 2 * n_ + 1)) {
+    if (!all_finite(y(), fos_->size())) {
       add_counters(rep);
       fail(0, tret, "non-finite solution");
     }
@@ -187,6 +189,7 @@ StepReport SundialsBaseline::advance(SemiDiscreteSystem& system, State& state, d
   if (!acceleration_in_y()) fos_->acceleration(t_, work_, work_.a);  // state.a = v̇(t_out)
   state = work_;
   w_out_ = w_;
+  d_out_ = d_;
   rep.last_dt = last_step();
   rep.factorizations = factorizations() - fact0;
   rep.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();

@@ -42,13 +42,15 @@ class SundialsBaseline : public Integrator {
   std::string name() const override { return name_; }
   std::vector<std::pair<std::string, std::string>> settings() const override;
   double external_work() const override { return w_; }
+  // W_damp = ∫ vᵀ C v dt, integrated by the solver as the component d of y (first_order_system.hpp).
+  double damping_work() const override { return d_; }
   void set_progress_log(std::ostream* log, const std::string& label, bool in_place = false) override {
     progress_log_ = log;
     progress_label_ = label;
     progress_in_place_ = in_place;
   }
-  // Checkpoint by re-initialization (docs/architecture.md "Checkpoints and resume"): only W_ext at the
-  // last output time is saved; restore() restarts SUNDIALS from the saved State as after a chart event.
+  // Checkpoint by re-initialization (docs/architecture.md "Checkpoints and resume"): only W_ext and W_damp
+  // at the last output time are saved; restore() restarts SUNDIALS from the saved State as after a chart event.
   // The step-size and order history is lost, so a resumed run agrees with an uninterrupted one to the
   // tolerances (rtol, atol), not bitwise.
   void save(IntegratorCheckpoint& c) const override;
@@ -67,7 +69,7 @@ class SundialsBaseline : public Integrator {
   virtual StepOutcome outcome(int flag) const = 0;
   virtual void pack(const State& s) = 0;              // s (with s.a) -> y (and ẏ)
   virtual void reinit() = 0;                          // re-initialize the solver at t_ from the packed y
-  virtual void unpack(State& s) = 0;                  // y (and ẏ) -> s.u, s.v, w_ (and s.a where ẏ holds it)
+  virtual void unpack(State& s) = 0;                  // y (and ẏ) -> s.u, s.v, w_, d_ (and s.a where ẏ holds it)
   virtual bool acceleration_in_y() const = 0;         // IDA: ẏ holds v̇; ARKStep: compute it
   virtual void add_counters(StepReport& rep) = 0;     // counters since the last call, then rebase
   virtual void rebase_counters() = 0;                 // after a re-initialization (counters restart at 0)
@@ -92,7 +94,7 @@ class SundialsBaseline : public Integrator {
   std::unique_ptr<FirstOrderSystem> fos_;
   Index n_ = 0;
   State work_;  // current charts; u, v, a are scratch inside callbacks
-  double t_ = 0.0, w_ = 0.0;
+  double t_ = 0.0, w_ = 0.0, d_ = 0.0;  // d_: W_damp
   NVectorPtr atol_v_;
   CallbackError errors_;
   std::string sundials_message_;
@@ -104,7 +106,7 @@ class SundialsBaseline : public Integrator {
   std::ostream* progress_log_ = nullptr;
   std::string progress_label_;
   bool progress_in_place_ = false;
-  double w_out_ = 0.0;  // W_ext at the end of the last advance() (checkpoints)
+  double w_out_ = 0.0, d_out_ = 0.0;  // W_ext, W_damp at the end of the last advance() (checkpoints)
   std::chrono::steady_clock::time_point last_progress_;
 };
 

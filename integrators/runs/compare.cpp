@@ -281,6 +281,7 @@ std::string encode_outcome(const RunSummary& s, double energy_error) {
      << " " << full(s.H_final) << " " << full(s.max_rel_drift) << " " << full(s.final_rel_drift) << " " << full(s.max_dL) << " "
      << full(s.max_dJ) << " " << full(s.ref_L) << " " << full(s.ref_J) << " " << full(s.max_strain_ratio) << " "
      << full(s.wall_seconds) << " " << full(energy_error) << "\n";
+  os << "damping " << (s.damped ? 1 : 0) << " " << full(s.damping_work) << "\n";
   for (const auto& [name, v] : s.final_monitors) os << "monitor " << full(v) << " " << name << "\n";
   os << "end\n";
   return os.str();
@@ -319,6 +320,9 @@ void decode_outcome(const std::string& text, RunSummary& s, double& energy_error
       for (double* p : {&s.t_end, &s.H0, &s.H_ref, &s.E_ref, &s.t_ref, &s.H_final, &s.max_rel_drift, &s.final_rel_drift,
                         &s.max_dL, &s.max_dJ, &s.ref_L, &s.ref_J, &s.max_strain_ratio, &s.wall_seconds, &energy_error})
         *p = read_number(ls);
+    } else if (key == "damping") {
+      s.damped = read_number(ls) != 0.0;
+      s.damping_work = read_number(ls);
     } else if (key == "monitor") {
       const double v = read_number(ls);
       std::string name;
@@ -463,7 +467,7 @@ void write_compare_summaries(const CompareOptions& o, const Problem& first, doub
        << " (full settings per run: summary.csv, <run>/run.json)\n";
     md << "- end time " << num(t_end) << " s; loads end at " << num(loads_end) << " s"
        << (t_end < loads_end ? " (after t_end: no energy-conservation figures)" : "") << "\n";
-    md << "- energy error: max |H − H_ref|/(K_ref + V_ref) after the loads end (H = K + V − W_ext; ref = first output at "
+    md << "- energy error: max |H − H_ref|/(K_ref + V_ref) after the loads end (H = K + V − W_ext, + W_damp with damping; ref = first output at "
           "or after the loads end); ΔL, ΔJ: max ‖L − L_ref‖, ‖J − J_ref‖ after the loads end\n";
     md << "- displacement error: max over shared output times of ‖monitors − reference‖₂ (monitors: ";
     for (size_t k = 0; k < result.monitors.size(); ++k) md << (k ? ", " : "") << result.monitors[k];

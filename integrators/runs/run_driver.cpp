@@ -46,6 +46,7 @@ void fill_summary_json(JsonFields& j, const RunSummary& s) {
   j.set("H_ref", s.H_ref);
   j.set("E_ref", s.E_ref);
   j.set("H_final", s.H_final);
+  if (s.damped) j.set("damping_work", s.damping_work);
   j.set("max_rel_energy_drift_after_loads", s.max_rel_drift);
   j.set("final_rel_energy_drift", s.final_rel_drift);
   j.set("max_abs_dL_after_loads", s.max_dL);
@@ -270,6 +271,7 @@ RunSummary run_dynamic(Problem& problem, const RunOptions& o) {
   sum.integrator = integrator->name();
   sum.settings = integrator->settings();
   sum.t_end = t_end;
+  sum.damped = model.has_damping();  // the summary then names H = K + V − W_ext + W_damp
   spec.integrator.name = sum.integrator;  // run.json shows what was actually run
   spec.integrator.settings = sum.settings;
   spec.time.dt = dt;
@@ -459,6 +461,7 @@ RunSummary run_dynamic(Problem& problem, const RunOptions& o) {
     if (inv.kinetic + inv.strain > 0.0)
       sum.max_strain_ratio = std::max(sum.max_strain_ratio, inv.strain / (inv.kinetic + inv.strain));
     sum.H_final = H;
+    sum.damping_work = integrator->damping_work();
     const double wall = elapsed();
     std::vector<double> mon;
     const bool vtu_now = pvd && out_index % vtu_every == 0;
@@ -631,7 +634,10 @@ void print_run_summary(std::ostream& out, const RunSummary& s) {
   line("nonlinear iterations", std::to_string(s.totals.nonlinear_iterations));
   line("linear setups / factorizations", std::to_string(s.totals.linear_setups) + " / " + std::to_string(s.totals.factorizations));
   line("director chart switches", std::to_string(s.totals.chart_switches));
-  line("energy H = K + V - W_ext: H0, H_ref", num(s.H0) + ", " + num(s.H_ref) + " (at t = " + num(s.t_ref) + ")");
+  // Damped models (docs/theory.md §8.5): the conserved total includes the dissipated energy W_damp.
+  line(s.damped ? "energy H = K + V - W_ext + W_damp: H0, H_ref" : "energy H = K + V - W_ext: H0, H_ref",
+       num(s.H0) + ", " + num(s.H_ref) + " (at t = " + num(s.t_ref) + ")");
+  if (s.damped) line("damping work W_damp (end)", num(s.damping_work));
   line("max |H - H_ref|/(K+V)_ref after loads", num(s.max_rel_drift));
   line("max |L - L_ref| after loads", num(s.max_dL) + " (|L_ref| = " + num(s.ref_L) + ")");
   line("max |J - J_ref| after loads", num(s.max_dJ) + " (|J_ref| = " + num(s.ref_J) + ")");

@@ -9,7 +9,8 @@
 //   run.json      resolved settings, versions, status and the final summary (rewritten at the end)
 // and prints one progress line (at most ~5 per second of wall time; the last one always).
 //
-// Energy bookkeeping: total H = K + V − W_ext, with W_ext accumulated by the integrator consistently with
+// Energy bookkeeping: total H = K + V − W_ext (+ W_damp, the energy dissipated by Rayleigh damping, for damped
+// models; docs/theory.md §8.5), with W_ext accumulated by the integrator consistently with
 // its own time discretization. rel_drift = (H − H_ref)/(K + V)_ref, where H_ref and (K + V)_ref are taken at
 // the first output time at or after the loads end (t = 0 for unloaded cases); it is NaN before that. (K + V,
 // not H, is the scale: a body started at rest holds exactly the work done on it, so H_ref ≈ 0.) Momentum changes ΔL, ΔJ are
@@ -115,6 +116,9 @@ struct RunSummary {
   double max_dL = 0.0, max_dJ = 0.0;          // max ‖L − L_ref‖, ‖J − J_ref‖ for t ≥ t_ref
   double ref_L = 0.0, ref_J = 0.0;            // ‖L_ref‖, ‖J_ref‖
   double max_strain_ratio = 0.0;   // max V/(K+V) (rigid-body checks)
+  // Rayleigh-damped model (docs/theory.md §8.5): H then includes + W_damp; damping_work = W_damp at the end.
+  bool damped = false;
+  double damping_work = 0.0;
   std::vector<std::pair<std::string, double>> final_monitors;
   double wall_seconds = 0.0;
   // CPU seconds of the run: the calling thread's when the run is single-threaded (as every run of
