@@ -75,6 +75,7 @@ struct CheckOptions {
   std::string out_dir;  // empty: results/<case name>
   std::string command;  // the full command line, recorded in run.json
   bool overwrite = false;
+  std::string state_file;  // static: start from this checkpoint (or run folder holding one)
 };
 
 void print_summary(std::ostream& out, const CaseSpec& c, const Discretization& d) {
@@ -358,8 +359,25 @@ int run_static_command(const CheckOptions& o) {
   const std::string dir = o.out_dir.empty() ? (fs::path("results") / problem.spec.name / "static").string() : o.out_dir;
   app::prepare_result_folder(dir, o.overwrite);
   std::cout << "shelldyn static: " << problem.spec.name << " -> " << dir << std::endl;
+  // --state: the configuration of a saved run (its checkpoint) as the starting point, its time as λ₀.
+  std::unique_ptr<State> start;
+  if (!o.state_file.empty()) {
+    std::string path = o.state_file;
+    if (fs::is_directory(path)) path = (fs::path(path) / checkpoint_file_name()).string();
+    if (!fs::exists(path))
+      throw std::invalid_argument("--state " + path + ": no such file (give a checkpoint.cbor, or the folder of a run "
+                                  "that wrote one: shelldyn run --checkpoint-every ...)");
+    Checkpoint c = read_checkpoint(path);
+    if (c.state.u.size() != problem.model->num_dofs() ||
+        static_cast<int>(c.state.charts.size()) != problem.model->mesh().num_nodes())
+      throw std::invalid_argument("--state " + path + ": the checkpoint holds " + std::to_string(c.state.u.size()) +
+                                  " DOFs, this case's model " + std::to_string(problem.model->num_dofs()) +
+                                  " (a checkpoint of another case or mesh?)");
+    start = std::make_unique<State>(c.state);
+    std::cout << "starting from " << path << " (t = " << c.state.t << ") at load factor " << c.state.t << std::endl;
+  }
   StaticReport report;
-  const auto rows = run_static(problem, dir, &std::cout, &report);
+  const auto rows = run_static(problem, dir, &std::cout, &report, start.get());
   std::cout << "summary: " << report.levels << " load levels, " << report.increments << " increments ("
             << report.failed_attempts << " failed attempts), " << report.newton_iterations << " Newton iterations, "
             << report.chart_switches << " director chart switches, " << report.wall_seconds << " s\n";
@@ -381,6 +399,9 @@ void add_static_command(CLI::App& app, Action& action, const std::string& comman
   sub->add_option("case", opts->case_path, "Case file (YAML), e.g. apps/cases/sze-hemisphere.yaml")->required();
   sub->add_option("-o,--output", opts->out_dir, "Result folder (default: results/<case>/static)");
   sub->add_flag("--overwrite", opts->overwrite, "Replace the results of an earlier command in the result folder");
+  sub->add_option("--state", opts->state_file,
+                  "Start from a saved state: a checkpoint.cbor of `shelldyn run` (or its run folder); its time is the "
+                  "starting load factor, velocities are ignored (default: the reference state at load factor 0)");
   sub->callback([opts, &action] { action = [opts] { return run_static_command(*opts); }; });
 }
 

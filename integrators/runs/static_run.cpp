@@ -58,7 +58,7 @@ StaticOptions static_options(const CaseSpec& spec, const Discretization* disc) {
 }
 
 std::vector<StaticRow> run_static(Problem& problem, const std::string& out_dir, std::ostream* log,
-                                  StaticReport* report_out) {
+                                  StaticReport* report_out, const State* start) {
   const CaseSpec& spec = problem.spec;
   const StaticOptions options = static_options(spec, &problem.disc);
   Model& model = *problem.model;
@@ -121,6 +121,19 @@ std::vector<StaticRow> run_static(Problem& problem, const std::string& out_dir, 
   };
 
   State state = model.initial_state();
+  if (start) {  // a saved state (shelldyn static --state): its configuration at load factor start->t
+    if (start->u.size() != state.u.size() || start->charts.size() != state.charts.size())
+      throw std::invalid_argument("the start state has " + std::to_string(start->u.size()) + " DOFs, this case's model " +
+                                  std::to_string(state.u.size()) + " (a state of another case?)");
+    if (!(start->t < spec.time.t_end))
+      throw std::invalid_argument("the start state is at load factor " + std::to_string(start->t) +
+                                  ", not below time.t_end = " + std::to_string(spec.time.t_end) +
+                                  ": nothing to solve (raise time.t_end)");
+    state.t = start->t;
+    state.u = start->u;
+    state.charts = start->charts;
+    model.adopt_charts(state.charts);
+  }
   StaticReport report;
   try {  // bad settings and I/O errors too must end in "incomplete: <reason>", not "running"
     record(state, 0, 0, 0.0, 0, "");

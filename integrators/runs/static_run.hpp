@@ -33,7 +33,10 @@ struct StaticRow {
 
 // out_dir empty: no files. log may be null. Returns the converged increments (the initial state is
 // row 0). Throws on failure after writing run.json with status "incomplete: <reason>".
+// start: begin from this state instead of the reference state (`shelldyn static --state`): its u and
+// director charts, at load factor λ₀ = start->t, velocities ignored; it must fit the model (the caller
+// checks) and λ₀ < time.t_end.
 std::vector<StaticRow> run_static(Problem& problem, const std::string& out_dir, std::ostream* log,
-                                  StaticReport* report = nullptr);
+                                  StaticReport* report = nullptr, const State* start = nullptr);
 
 }  // namespace shelldyn

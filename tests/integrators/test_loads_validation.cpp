@@ -349,5 +349,48 @@ time: {dt: 1.0e-3, t_end: 0.2}
   }
 }
 
+// `shelldyn static --state` (integrators/runs/static_run.hpp): a static solve that starts from a saved state
+// at its load factor continues the path: from the state at λ = 0.5 to λ = 1 it ends where the solve from 0
+// ends (to the Newton tolerance), and its first row is the saved state itself.
+TEST(LoadsValidation, StaticSolveStartsFromASavedState) {
+  const char* text = R"(
+mesh: {generator: rectangle, a: 10, b: 1, nx: 8, ny: 1}
+material: {E: 1.2e6, nu: 0, rho: 1, thickness: 0.1}
+sets: {tip: {point: [10, 0, 0]}}
+boundary_conditions: [{set: left, fix: [ux, uy, uz, director]}]
+loads: [{type: gravity, direction: [0, 0, -1], amplitude: 1.0, function: {type: ramp, t1: 1}}]
+monitors: [{name: w, set: tip, quantity: uz}]
+integrator: {name: static, increment: 0.25, tol: 1e-12}
+time: {dt: 0.25, t_end: 1}
+)";
+  Problem full = make_problem(load_case_from_string(text, "gravity-cantilever.yaml"));
+  const auto rows_full = run_static(full, "", nullptr);
+  Problem half = make_problem(load_case_from_string(text, "gravity-cantilever.yaml"));
+  State s = half.initial_state();
+  StaticSolver(*half.model, static_options(half.spec)).solve(s, 0.5);
+  const double w_half = monitor(half, s, 0);
+  Problem cont = make_problem(load_case_from_string(text, "gravity-cantilever.yaml"));
+  const auto rows = run_static(cont, "", nullptr, nullptr, &s);
+  const double w_full = rows_full.back().monitors[0], w_cont = rows.back().monitors[0];
+  std::printf("static from the state at 0.5: %zu rows (from 0: %zu), w_tip %.12e vs %.12e (from 0), rel. diff %.1e\n",
+              rows.size(), rows_full.size(), w_cont, w_full, std::abs(w_cont / w_full - 1));
+  EXPECT_LT(w_full, -0.8);  // linear theory: -1.25, 12.5 % of L: geometrically nonlinear
+  ASSERT_EQ(rows.size(), 3u);  // λ = 0.5 (the saved state), 0.75, 1
+  EXPECT_EQ(rows.front().load_factor, 0.5);
+  EXPECT_EQ(rows.front().monitors[0], w_half);
+  EXPECT_EQ(rows.back().load_factor, 1.0);
+  EXPECT_NEAR(w_cont / w_full, 1.0, 1e-9);
+  // A state at or past time.t_end: nothing to solve.
+  State late = s;
+  late.t = 1.0;
+  Problem again = make_problem(load_case_from_string(text, "gravity-cantilever.yaml"));
+  try {
+    run_static(again, "", nullptr, nullptr, &late);
+    ADD_FAILURE() << "no error for a start state at t_end";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("nothing to solve"), std::string::npos) << e.what();
+  }
+}
+
 }  // namespace
 }  // namespace shelldyn
