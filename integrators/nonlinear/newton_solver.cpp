@@ -192,7 +192,8 @@ const LinearSolver& NewtonSolver::linear_solver() const { return sun_linear_solv
 void NewtonSolver::invalidate_jacobian() { impl_->force_setup = true; }
 int NewtonSolver::iterations_since_setup() const {
   const Impl& s = *impl_;
-  return s.have_jacobian && !s.force_setup ? s.since_setup : -1;
+  // A Jacobian that has served max_setup_calls iterations is refreshed at the next one: nothing to resume.
+  return s.have_jacobian && !s.force_setup && s.since_setup < s.opt.max_setup_calls ? s.since_setup : -1;
 }
 void NewtonSolver::resume_after_setup(int k) { impl_->resume_since_setup = k; }
 
