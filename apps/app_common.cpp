@@ -143,7 +143,7 @@ void check_output_folder(const std::string& dir) {
 void prepare_result_folder(const std::string& dir, bool overwrite) {
   check_output_folder(dir);
   static const char* outputs[] = {"run.json",    "run.json.tmp", "history.csv",  "fields.pvd", "fields.pvd.tmp",
-                                  "checkpoint.cbor", "checkpoint.cbor.tmp", "static.csv", "summary.csv",
+                                  "checkpoint.cbor", "checkpoint.cbor.tmp", "run.json.reserve", "static.csv", "summary.csv",
                                   "summary.md", "energy.png",  "momentum.png", "monitors.png", "work_precision.png"};
   std::error_code ec;
   const fs::path d(dir);

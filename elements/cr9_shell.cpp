@@ -243,7 +243,7 @@ CorotationalFrame CR9Shell::frame(const Vec45& u, const Charts& charts) const {
 }
 
 double CR9Shell::membrane(const Mat39& t1, const Mat39& t0, double c1, double c0, double b1, double b0, Vec45* fL,
-                          Mat45* kL) const {
+                          Mat45* kL, const StepState* n0) const {
   const Eigen::Matrix3d hD1 = mat_.thickness * D1_;
   Eigen::Matrix<double, 27, 1> fm = Eigen::Matrix<double, 27, 1>::Zero();
   Eigen::Matrix<double, 27, 27> km;
@@ -251,7 +251,8 @@ double CR9Shell::membrane(const Mat39& t1, const Mat39& t0, double c1, double c0
   if (kL) km.setZero(), Hs.setZero();
   const Eigen::Map<const Eigen::Matrix<double, 27, 1>> v1(t1.data()), v0(t0.data());
   double U = 0.0;
-  for (const GaussPoint& gp : gp_) {
+  for (size_t g = 0; g < gp_.size(); ++g) {
+    const GaussPoint& gp = gp_[g];
     // ε_m,c = L_m,c·t + ½ Σ_ij H_c(i,j) t_i·t_j (quadratic, §4.7); gradient B_m = L_m + H_m t.
     Eigen::Vector3d e1, e0 = Eigen::Vector3d::Zero();
     Eigen::Matrix<double, 3, 27> Bm;
@@ -262,7 +263,11 @@ double CR9Shell::membrane(const Mat39& t1, const Mat39& t0, double c1, double c0
     for (int c = 0; c < 3; ++c) {
       const Mat39 tH1 = t1.lazyProduct(gp.Hm[c]);
       e1(c) = gp.Lm.row(c).dot(v1) + 0.5 * tH1.cwiseProduct(t1).sum();
-      if (need0) {
+      if (need0 && n0) {  // t0's strain and products from the step state (same arithmetic)
+        e0(c) = n0->e[g](c);
+        const Mat39 tHb = b1 * tH1 + b0 * n0->tH[g][static_cast<size_t>(c)];
+        Bm.row(c) = gp.Lm.row(c) + Eigen::Map<const Row27>(tHb.data());
+      } else if (need0) {
         const Mat39 tH0 = t0.lazyProduct(gp.Hm[c]);
         e0(c) = gp.Lm.row(c).dot(v0) + 0.5 * tH0.cwiseProduct(t0).sum();
         const Mat39 tHb = b1 * tH1 + b0 * tH0;
@@ -354,6 +359,47 @@ double CR9Shell::algorithmic_internal(const Vec45& u_n, const Vec45& u_np1, cons
     fr.tangent(kL, fL, opt_.geometric_stiffness, K);
   } else {
     U += membrane(t1, t0, c1, c0, 1.0 - alpha_f, alpha_f, &fL, nullptr);
+  }
+  if (F) *F = fr.apply_transpose(fL);
+  return U;
+}
+
+void CR9Shell::step_state(const Vec45& u_n, const Charts& charts, StepState* st) const {
+  local_increments(u_n, charts, &st->w);
+  const Mat39 t0 = translations(st->w);
+  const Eigen::Map<const Eigen::Matrix<double, 27, 1>> v0(t0.data());
+  for (size_t g = 0; g < gp_.size(); ++g)
+    for (int c = 0; c < 3; ++c) {  // the expressions of membrane(), so that results are bitwise the same
+      Mat39& tH0 = st->tH[g][static_cast<size_t>(c)];
+      tH0 = t0.lazyProduct(gp_[g].Hm[c]);
+      st->e[g](c) = gp_[g].Lm.row(c).dot(v0) + 0.5 * tH0.cwiseProduct(t0).sum();
+    }
+}
+
+double CR9Shell::algorithmic_internal(const StepState& sn, const Vec45& u_n, const Vec45& u_np1, const Charts& charts,
+                                      double alpha_f, double xi, Vec45* F, Mat45* K) const {
+  if (!(alpha_f >= 0.0 && alpha_f <= 1.0) || !std::isfinite(xi)) {
+    std::ostringstream os;
+    os << "CR9Shell::algorithmic_internal: alpha_f = " << alpha_f << " must lie in [0,1] and xi = " << xi
+       << " must be finite";
+    throw std::invalid_argument(os.str());
+  }
+  // As the plain overload, with w_n, ε_m(t_n) and t_n H_m from the step state.
+  const Vec45& wn = sn.w;
+  Vec45 w1;
+  local_increments(u_np1, charts, &w1);
+  const Vec45 u_mid = (1.0 - alpha_f) * u_np1 + alpha_f * u_n;
+  const CorotationalFrame fr = local_increments(u_mid, charts, nullptr);
+  const double c1 = 1.0 - alpha_f + xi, c0 = alpha_f - xi;
+  Vec45 fL = Kbs_ * (c1 * w1 + c0 * wn);
+  double U = 0.5 * w1.dot(Kbs_ * w1);
+  const Mat39 t1 = translations(w1), t0 = translations(wn);
+  if (K) {
+    Mat45 kL = Kbs_;
+    U += membrane(t1, t0, c1, c0, 1.0 - alpha_f, alpha_f, &fL, &kL, &sn);
+    fr.tangent(kL, fL, opt_.geometric_stiffness, K);
+  } else {
+    U += membrane(t1, t0, c1, c0, 1.0 - alpha_f, alpha_f, &fL, nullptr, &sn);
   }
   if (F) *F = fr.apply_transpose(fL);
   return U;

@@ -64,6 +64,19 @@ class CR9Shell {
   double algorithmic_internal(const Vec45& u_n, const Vec45& u_np1, const Charts& charts, double alpha_f,
                               double xi, Vec45* F, Mat45* K) const;
 
+  // What §6.3 needs from the step's start configuration u_n, which is fixed during a step's Newton
+  // iterations: the local increments w_n and, per Gauss point, the membrane strains ε_m(t_n) and the
+  // products t_n H_m,c. Computed once per step (step_state()), used by every residual and tangent of the
+  // step (the overload of algorithmic_internal below), with results identical to the plain overload.
+  struct StepState {
+    Vec45 w;
+    std::array<Eigen::Vector3d, 9> e;                          // ε_m at t_n per Gauss point
+    std::array<std::array<Eigen::Matrix<double, 3, 9>, 3>, 9> tH;  // t_n H_m,c per Gauss point and c
+  };
+  void step_state(const Vec45& u_n, const Charts& charts, StepState* st) const;
+  double algorithmic_internal(const StepState& sn, const Vec45& u_n, const Vec45& u_np1, const Charts& charts,
+                              double alpha_f, double xi, Vec45* F, Mat45* K) const;
+
   void mass(const Vec45& u, const Charts& charts, Mat45* M) const;                        // §5.2
   void inertial(const Vec45& u, const Vec45& v, const Charts& charts, Vec45* Fm) const;  // §5.2 F_m
   double kinetic(const Vec45& u, const Vec45& v, const Charts& charts) const;             // §5.1
@@ -100,8 +113,9 @@ class CR9Shell {
   // Local response of the membrane part with strains from the local translations t1, t0 weighted by
   // c1, c0 and strain gradient evaluated at t̄ = b1 t1 + b0 t0 (§6.3; internal(): c1 = b1 = 1, c0 = b0 = 0).
   // Adds to fL and kL (t rows only); returns the membrane energy at t1.
+  // With n0 (the step state of t0), its strains and products are taken from there instead of recomputed.
   double membrane(const Mat39& t1, const Mat39& t0, double c1, double c0, double b1, double b0, Vec45* fL,
-                  Mat45* kL) const;
+                  Mat45* kL, const StepState* n0 = nullptr) const;
   // Local increments w = [t_i, Δθ_i] of u and the frame at u.
   CorotationalFrame local_increments(const Vec45& u, const Charts& charts, Vec45* w) const;
 

@@ -8,6 +8,11 @@
 #include <stdexcept>
 
 namespace shelldyn {
+namespace {
+std::string write_error_reason(int err) {
+  return err == ENOSPC ? std::string("the disk is full (free space and rerun)") : std::string(std::strerror(err));
+}
+}  // namespace
 
 const std::vector<std::string>& history_standard_columns() {
   static const std::vector<std::string> cols = {
@@ -27,7 +32,7 @@ HistoryWriter::HistoryWriter(const std::string& path, std::vector<std::string> e
   if (!file_) throw std::runtime_error(path + ": cannot create history file: " + std::strerror(errno));
   for (size_t k = 0; k < columns_.size(); ++k) std::fprintf(file_, "%s%s", k ? "," : "", columns_[k].c_str());
   std::fputc('\n', file_);
-  if (std::fflush(file_) != 0) throw std::runtime_error(path_ + ": write error: " + std::strerror(errno));
+  if (std::fflush(file_) != 0) throw std::runtime_error(path_ + ": cannot write history.csv: " + write_error_reason(errno));
 }
 
 HistoryWriter::HistoryWriter(const std::string& path, std::vector<std::string> extra_columns,
@@ -78,6 +83,8 @@ void HistoryWriter::write(const HistoryRow& r) {
     throw std::invalid_argument("history.csv: row has " + std::to_string(r.extra.size()) + " extra and " +
                                 std::to_string(r.monitors.size()) + " monitor values, header expects " +
                                 std::to_string(num_extra_) + " and " + std::to_string(num_monitors_));
+  if (!file_) throw std::runtime_error(path_ + ": closed after an earlier write error");
+  const long row_start = std::ftell(file_);
   std::fprintf(file_, "%lld", r.step);
   const double reals[] = {r.t, r.dt, r.kinetic, r.strain, r.external_work, r.total, r.rel_drift,
                           r.L.x(), r.L.y(), r.L.z(), r.J.x(), r.J.y(), r.J.z()};
@@ -86,9 +93,18 @@ void HistoryWriter::write(const HistoryRow& r) {
   for (double v : r.extra) std::fprintf(file_, ",%.17g", v);
   for (double v : r.monitors) std::fprintf(file_, ",%.17g", v);
   std::fputc('\n', file_);
-  if (std::fflush(file_) != 0 || std::ferror(file_))
-    throw std::runtime_error(path_ + ": cannot write history.csv: " +
-                             (errno == ENOSPC ? std::string("the disk is full (free space and rerun)") : std::strerror(errno)));
+  if (std::fflush(file_) != 0 || std::ferror(file_)) {
+    const int err = errno;
+    // No half row: close, then cut the file back to the rows written whole (close first, so that
+    // nothing left in the stdio buffer lands after the cut).
+    std::fclose(file_);
+    file_ = nullptr;
+    if (row_start >= 0) {
+      const int rc = truncate(path_.c_str(), static_cast<off_t>(row_start));
+      (void)rc;  // if even this fails, the write error below is still the one to report
+    }
+    throw std::runtime_error(path_ + ": cannot write history.csv: " + write_error_reason(err));
+  }
 }
 
 }  // namespace shelldyn

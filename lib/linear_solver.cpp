@@ -3,11 +3,17 @@
 // docs/dependencies.md §§3.2, 5.
 #include "lib/linear_solver.hpp"
 
+#include "lib/profile.hpp"
+
 #include <Eigen/SparseCholesky>
 #include <cholmod.h>
 #include <klu.h>
 
+#include <dlfcn.h>
+#include <omp.h>
+
 #include <algorithm>
+#include <exception>
 #include <chrono>
 #include <cmath>
 #include <cstring>
@@ -57,9 +63,47 @@ void check_same_shape(const CscView& A, Index n, Index nnz, const std::string& w
 // ------------------------------------------------------------------------------------------------
 // CHOLMOD
 // ------------------------------------------------------------------------------------------------
+// No hidden threads (architecture: the only parallelism is the element loops' OpenMP team, sized by
+// --threads). Two sources exist in Debian 12's CHOLMOD 3.0 / OpenBLAS build:
+//  - CHOLMOD's supernodal kernels open OpenMP regions with a fixed num_threads(4) clause, which
+//    overrides omp_set_num_threads(); on a 2-core machine those threads spin and burn CPU. We call
+//    CHOLMOD with OpenMP's max-active-levels set to 0 (single_threaded below), so they run on one thread.
+//  - OpenBLAS (pthread build) starts one thread per core for the dense supernode kernels; on matrices of
+//    a few thousand unknowns they cost more than they save. openblas_set_num_threads(1) is called once
+//    if the symbol is present (looked up at run time, so a reference BLAS works as well).
+void limit_blas_threads() {
+  static const bool once = [] {
+    using SetThreads = void (*)(int);
+    if (void* f = dlsym(RTLD_DEFAULT, "openblas_set_num_threads"))
+      reinterpret_cast<SetThreads>(f)(1);
+    return true;
+  }();
+  (void)once;
+}
+
+template <class F>
+void single_threaded(const F& f) {
+  if (omp_in_parallel()) {  // already inside a region: CHOLMOD's regions nest and stay inactive
+    f();
+    return;
+  }
+  // max-active-levels 0 makes every region started by this call run on the calling thread only; it is
+  // restored at once (CHOLMOD is called between element loops, never concurrently with them).
+  const int levels = omp_get_max_active_levels();
+  omp_set_max_active_levels(0);
+  try {
+    f();
+  } catch (...) {
+    omp_set_max_active_levels(levels);
+    throw;
+  }
+  omp_set_max_active_levels(levels);
+}
+
 class CholmodSolver final : public LinearSolver {
  public:
   CholmodSolver() {
+    limit_blas_threads();
     cholmod_l_start(&cc_);
     cc_.print = 0;  // report through exceptions, not stderr
     cc_.nmethods = 1;
@@ -82,11 +126,12 @@ class CholmodSolver final : public LinearSolver {
   bool factorized() const override { return factorized_; }
 
   void analyze(const CscView& A) override {
+    profile::Scope prof(profile::Section::analyze);
     check_csc_pattern(A, "cholmod");
     const auto t0 = Clock::now();
     release();
     cholmod_sparse S = header(A);
-    L_ = cholmod_l_analyze(&S, &cc_);
+    single_threaded([&] { L_ = cholmod_l_analyze(&S, &cc_); });
     if (L_ == nullptr || cc_.status < CHOLMOD_OK)
       throw std::runtime_error("cholmod: cholmod_l_analyze failed (status " +
                                std::to_string(cc_.status) + ")");
@@ -97,13 +142,14 @@ class CholmodSolver final : public LinearSolver {
   }
 
   void factorize(const CscView& A) override {
+    profile::Scope prof(profile::Section::factorize);
     if (L_ == nullptr) analyze(A);
     check_same_shape(A, n_, nnz_, "cholmod");
     check_values(A, "cholmod");
     factorized_ = false;
     const auto t0 = Clock::now();
     cholmod_sparse S = header(A);
-    cholmod_l_factorize(&S, L_, &cc_);
+    single_threaded([&] { cholmod_l_factorize(&S, L_, &cc_); });
     if (cc_.status == CHOLMOD_NOT_POSDEF && !ldlt_) {
       // Documented fallback: switch to simplicial LDLᵀ for good (header), one re-analysis.
       ldlt_ = true;
@@ -146,6 +192,7 @@ class CholmodSolver final : public LinearSolver {
   }
 
   void solve(const double* b, double* x) const override {
+    profile::Scope prof(profile::Section::solve);
     if (!factorized_) throw std::logic_error("cholmod: solve() called without a valid factorization");
     const auto t0 = Clock::now();
     cholmod_dense B{};
@@ -157,7 +204,9 @@ class CholmodSolver final : public LinearSolver {
     B.xtype = CHOLMOD_REAL;
     B.dtype = CHOLMOD_DOUBLE;
     // solve2 reuses X, Y, E across calls: no allocation per solve.
-    if (!cholmod_l_solve2(CHOLMOD_A, L_, &B, nullptr, &X_, nullptr, &Y_, &E_, &cc_))
+    int ok = 0;
+    single_threaded([&] { ok = cholmod_l_solve2(CHOLMOD_A, L_, &B, nullptr, &X_, nullptr, &Y_, &E_, &cc_); });
+    if (!ok)
       throw std::runtime_error("cholmod: cholmod_l_solve2 failed (status " +
                                std::to_string(cc_.status) + ")");
     std::memcpy(x, X_->x, sizeof(double) * static_cast<size_t>(n_));  // alias-safe: X_ is separate
@@ -211,6 +260,7 @@ class EigenLdltSolver final : public LinearSolver {
   bool factorized() const override { return factorized_; }
 
   void analyze(const CscView& A) override {
+    profile::Scope prof(profile::Section::analyze);
     check_csc_pattern(A, "eigen-ldlt");
     const auto t0 = Clock::now();
     factorized_ = false;
@@ -226,6 +276,7 @@ class EigenLdltSolver final : public LinearSolver {
   }
 
   void factorize(const CscView& A) override {
+    profile::Scope prof(profile::Section::factorize);
     if (!analysed_) analyze(A);
     check_same_shape(A, n_, nnz_, "eigen-ldlt");
     check_values(A, "eigen-ldlt");
@@ -258,6 +309,7 @@ class EigenLdltSolver final : public LinearSolver {
   }
 
   void solve(const double* b, double* x) const override {
+    profile::Scope prof(profile::Section::solve);
     if (!factorized_)
       throw std::logic_error("eigen-ldlt: solve() called without a valid factorization");
     const auto t0 = Clock::now();
@@ -296,6 +348,7 @@ class KluSolver final : public LinearSolver {
   bool factorized() const override { return factorized_; }
 
   void analyze(const CscView& A) override {
+    profile::Scope prof(profile::Section::analyze);
     check_csc_pattern(A, "klu");
     const auto t0 = Clock::now();
     release();
@@ -311,6 +364,7 @@ class KluSolver final : public LinearSolver {
   }
 
   void factorize(const CscView& A) override {
+    profile::Scope prof(profile::Section::factorize);
     if (symbolic_ == nullptr) analyze(A);
     check_same_shape(A, n_, nnz_, "klu");
     check_values(A, "klu");
@@ -348,6 +402,7 @@ class KluSolver final : public LinearSolver {
   }
 
   void solve(const double* b, double* x) const override {
+    profile::Scope prof(profile::Section::solve);
     if (!factorized_) throw std::logic_error("klu: solve() called without a valid factorization");
     const auto t0 = Clock::now();
     if (x != b) std::memcpy(x, b, sizeof(double) * static_cast<size_t>(n_));

@@ -1,9 +1,11 @@
 #include "lib/model.hpp"
 
 #include "elements/exact_energy.hpp"
+#include "lib/profile.hpp"
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <exception>
 #include <mutex>
 
@@ -115,6 +117,7 @@ CR9Shell::Charts Model::element_charts(int e, const std::vector<DirectorChart>& 
 
 double Model::internal(const Eigen::VectorXd& u, const std::vector<DirectorChart>& charts, double* F,
                        SparseMatrix* K) const {
+  profile::Scope prof(K ? profile::Section::tangent : profile::Section::internal_force);
   if (F) std::fill(F, F + num_dofs(), 0.0);
   if (K) K->set_zero();
   std::vector<double> energy(elements_.size(), 0.0);
@@ -133,6 +136,27 @@ double Model::internal(const Eigen::VectorXd& u, const std::vector<DirectorChart
 double Model::algorithmic_internal(const Eigen::VectorXd& u_n, const Eigen::VectorXd& u_np1,
                                    const std::vector<DirectorChart>& charts, double alpha_f, double xi,
                                    double* F, SparseMatrix* K) const {
+  StepCache& cache = *step_cache_;
+  std::lock_guard<std::mutex> lock(cache.mutex);
+  const bool same_start = cache.valid && cache.u_n.size() == u_n.size() && cache.charts.size() == charts.size() &&
+                          std::memcmp(cache.u_n.data(), u_n.data(), sizeof(double) * static_cast<size_t>(u_n.size())) == 0 &&
+                          std::equal(charts.begin(), charts.end(), cache.charts.begin(), [](const DirectorChart& a, const DirectorChart& b) {
+                            return a.n == b.n && a.m == b.m && a.l == b.l && a.s == b.s;
+                          });
+  if (!same_start) {
+    profile::Scope prof(profile::Section::step_state);
+    cache.valid = false;
+    cache.states.resize(elements_.size());
+    for_each_element(assembler_, [&](int e) {
+      CR9Shell::Vec45 un;
+      gather(e, u_n, un);
+      elements_[static_cast<size_t>(e)].step_state(un, element_charts(e, charts), &cache.states[static_cast<size_t>(e)]);
+    });
+    cache.u_n = u_n;
+    cache.charts = charts;
+    cache.valid = true;
+  }
+  profile::Scope prof(K ? profile::Section::tangent : profile::Section::internal_force);
   if (F) std::fill(F, F + num_dofs(), 0.0);
   if (K) K->set_zero();
   std::vector<double> energy(elements_.size(), 0.0);
@@ -142,7 +166,8 @@ double Model::algorithmic_internal(const Eigen::VectorXd& u_n, const Eigen::Vect
     gather(e, u_n, un);
     gather(e, u_np1, unp1);
     energy[static_cast<size_t>(e)] = elements_[static_cast<size_t>(e)].algorithmic_internal(
-        un, unp1, element_charts(e, charts), alpha_f, xi, F ? &fe : nullptr, K ? &ke : nullptr);
+        cache.states[static_cast<size_t>(e)], un, unp1, element_charts(e, charts), alpha_f, xi, F ? &fe : nullptr,
+        K ? &ke : nullptr);
     if (F) assembler_.add_vector(e, fe, F);
     if (K) assembler_.add_matrix(e, ke, K->values.data());
   });
@@ -150,6 +175,7 @@ double Model::algorithmic_internal(const Eigen::VectorXd& u_n, const Eigen::Vect
 }
 
 void Model::mass(const Eigen::VectorXd& u, const std::vector<DirectorChart>& charts, SparseMatrix& M) const {
+  profile::Scope prof(profile::Section::mass);
   M.set_zero();
   for_each_element(assembler_, [&](int e) {
     CR9Shell::Vec45 ue;
@@ -162,6 +188,7 @@ void Model::mass(const Eigen::VectorXd& u, const std::vector<DirectorChart>& cha
 
 void Model::inertial(const Eigen::VectorXd& u, const Eigen::VectorXd& v, const std::vector<DirectorChart>& charts,
                      double* Fm) const {
+  profile::Scope prof(profile::Section::inertia);
   std::fill(Fm, Fm + num_dofs(), 0.0);
   for_each_element(assembler_, [&](int e) {
     CR9Shell::Vec45 ue, ve, fe;
@@ -175,6 +202,7 @@ void Model::inertial(const Eigen::VectorXd& u, const Eigen::VectorXd& v, const s
 
 void Model::inertia_force(const Eigen::VectorXd& u, const Eigen::VectorXd& v, const Eigen::VectorXd& a,
                           const std::vector<DirectorChart>& charts, double* out) const {
+  profile::Scope prof(profile::Section::inertia);
   std::fill(out, out + num_dofs(), 0.0);
   for_each_element(assembler_, [&](int e) {
     CR9Shell::Vec45 ue, ve, ae, fe;
@@ -193,6 +221,7 @@ void Model::inertia_force(const Eigen::VectorXd& u, const Eigen::VectorXd& v, co
 
 void Model::external(double t, const Eigen::VectorXd& u, const std::vector<DirectorChart>& charts,
                      double* F) const {
+  profile::Scope prof(profile::Section::external);
   std::fill(F, F + num_dofs(), 0.0);
   for (const auto& load : loads_) {
     const double f = load.function(t);
@@ -213,6 +242,7 @@ void Model::external(double t, const Eigen::VectorXd& u, const std::vector<Direc
 
 void Model::add_load_stiffness(double t, const Eigen::VectorXd& u, const std::vector<DirectorChart>& charts,
                                SparseMatrix& K) const {
+  profile::Scope prof(profile::Section::external);
   for (const auto& load : loads_) {
     const double f = load.function(t);
     if (f == 0.0 || load.kind != NodalLoad::Kind::Moment) continue;

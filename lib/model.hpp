@@ -22,6 +22,8 @@
 #include "lib/time_function.hpp"
 
 #include <Eigen/Core>
+#include <memory>
+#include <mutex>
 #include <vector>
 
 namespace shelldyn {
@@ -146,6 +148,19 @@ class Model final : public SemiDiscreteSystem {
   std::vector<FollowerPressure> follower_;
   bool full_load_tangent_ = false;
   SparseMatrix damping_;  // empty values: no damping
+
+  // Per-step element state at u_n for algorithmic_internal() (CR9Shell::StepState): u_n is fixed during a
+  // step's Newton iterations, so its frame, local increments and membrane products are computed at the
+  // first call with a new (u_n, charts) and reused by the step's other residuals and tangents. Internal
+  // to the Model: results are identical with or without it. The mutex serialises concurrent callers.
+  struct StepCache {
+    std::mutex mutex;
+    Eigen::VectorXd u_n;
+    std::vector<DirectorChart> charts;
+    std::vector<CR9Shell::StepState> states;
+    bool valid = false;
+  };
+  std::unique_ptr<StepCache> step_cache_ = std::make_unique<StepCache>();
 };
 
 }  // namespace shelldyn

@@ -3,6 +3,7 @@
 #include <Eigen/Core>
 #include <nlohmann/json.hpp>
 
+#include <fcntl.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -231,6 +232,22 @@ void write_text_atomically(const std::string& path, const std::string& text, con
   const int err = errno ? errno : EIO;
   if (std::fclose(f) != 0 || !written) fail("write", written ? (errno ? errno : EIO) : err);
   if (std::rename(tmp.c_str(), path.c_str()) != 0) fail("replace", errno);
+}
+
+DiskReserve::DiskReserve(const std::string& path, long long bytes) {
+  const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  if (fd < 0) return;
+  // posix_fallocate really allocates the blocks (glibc writes them where the file system cannot).
+  const bool ok = posix_fallocate(fd, 0, static_cast<off_t>(bytes)) == 0 && fsync(fd) == 0;
+  ::close(fd);
+  if (ok) path_ = path;
+  else std::remove(path.c_str());
+}
+
+void DiskReserve::release() {
+  if (path_.empty()) return;
+  std::remove(path_.c_str());
+  path_.clear();
 }
 
 void write_run_json(const std::string& path, const CaseSpec& spec, const RunInfo& info) {

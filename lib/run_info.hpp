@@ -66,4 +66,23 @@ void write_run_json(const std::string& path, const CaseSpec& spec, const RunInfo
 // The same for any text file; `what` names it in errors.
 void write_text_atomically(const std::string& path, const std::string& text, const std::string& what);
 
+// Room for the last word on a full disk (docs/architecture.md "Checkpoints and resume"): a run keeps
+// `path` (DIR/run.json.reserve) allocated while it runs and deletes it right before writing its final
+// status, so that when the run's own outputs fill the disk, run.json can still say why the run ended
+// instead of staying "incomplete: running". Best effort: if the space cannot be allocated there is no
+// reserve (and no error). The destructor deletes the file too.
+class DiskReserve {
+ public:
+  DiskReserve() = default;
+  DiskReserve(const std::string& path, long long bytes);
+  ~DiskReserve() { release(); }
+  DiskReserve(const DiskReserve&) = delete;
+  DiskReserve& operator=(const DiskReserve&) = delete;
+  void release();
+  bool held() const { return !path_.empty(); }
+
+ private:
+  std::string path_;
+};
+
 }  // namespace shelldyn

@@ -67,6 +67,56 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
   double external_work() const override { return work_; }
   const Data& diagnostics() const override { return diag_; }
 
+  // Checkpoint (docs/architecture.md "Checkpoints and resume"): the State carries d, v and, in
+  // State::pdot, the embedded director velocities w (theory §2), which the step needs exactly; the
+  // directors p follow from q and the charts, also in the State. Beyond it a step depends on W_ext,
+  // the step counter (messages), the last step size (a new h refreshes the iteration matrix) and, with
+  // modified Newton, the K̄ in use and the iterations done with it: restore() makes the next setup
+  // replay that K̄ and resume the refresh count, so the continued run is bitwise the uninterrupted
+  // one. The diagnostics (EmExactDiagnostics) are saved too, so they cover the whole run.
+  void save(IntegratorCheckpoint& c) const override {
+    if (!newton_) throw std::logic_error("em-exact: save() before initialize()");
+    c.exact = true;
+    c.scalars["W_ext"] = work_;
+    c.scalars["steps"] = static_cast<double>(steps_);
+    c.scalars["last_h"] = last_h_;
+    c.scalars["diag_dissipation"] = diag_.dissipation;
+    c.scalars["diag_min_step_dissipation"] = diag_.min_step_dissipation;
+    c.scalars["diag_max_residual"] = diag_.max_residual;
+    c.scalars["diag_max_beta_z"] = diag_.max_beta_z;
+    c.scalars["diag_rigid_guards"] = static_cast<double>(diag_.rigid_guards);
+    const int since = nopt_.modified ? newton_->iterations_since_setup() : -1;
+    c.scalars["newton_since_setup"] = since;
+    if (since >= 0) c.vectors["kbar"] = Eigen::Map<const Eigen::VectorXd>(kbar_.data(), static_cast<Index>(kbar_.size()));
+  }
+
+  void restore(SemiDiscreteSystem& sys, State& s, const IntegratorCheckpoint& c) override {
+    if (!newton_ || model_ != &sys) throw std::logic_error("em-exact: restore() before initialize() (or on another system)");
+    const Index n = sys.num_dofs();
+    if (s.u.size() != n || s.v.size() != n || s.a.size() != n)
+      throw std::runtime_error("em-exact: checkpoint state has the wrong size for this model");
+    if (s.pdot.size() != 3 * nn_)
+      throw std::runtime_error("em-exact: the checkpoint has no director velocities (State::pdot) for " +
+                               std::to_string(nn_) + " nodes; it was not written by em-exact");
+    work_ = c.scalar("W_ext");
+    steps_ = static_cast<long>(c.scalar("steps"));
+    last_h_ = c.scalar("last_h");
+    diag_.dissipation = c.scalar("diag_dissipation");
+    diag_.min_step_dissipation = c.scalar("diag_min_step_dissipation");
+    diag_.max_residual = c.scalar("diag_max_residual");
+    diag_.max_beta_z = c.scalar("diag_max_beta_z");
+    diag_.rigid_guards = static_cast<long>(c.scalar("diag_rigid_guards"));
+    const int since = static_cast<int>(c.scalar("newton_since_setup"));
+    replay_kbar_ = false;
+    if (nopt_.modified && since >= 0) {
+      const Eigen::VectorXd& k = c.vector("kbar");
+      if (k.size() != sys.pattern()->nnz()) throw std::runtime_error("em-exact: checkpoint K̄ has the wrong size");
+      kbar_.assign(k.data(), k.data() + k.size());
+      replay_kbar_ = true;
+      newton_->resume_after_setup(since);
+    }
+  }
+
   void initialize(SemiDiscreteSystem& sys, State& s) override {
     model_ = dynamic_cast<Model*>(&sys);
     if (!model_)
@@ -110,6 +160,7 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
       double h = std::min(dt_, t_out - s.t);
       if (t_out - (s.t + h) < 1e-9 * dt_) h = t_out - s.t;
       step_with_cuts(s, h, 0, rep);
+      if (stop_requested()) break;  // at a step boundary: the driver checkpoints and stops
     }
     rep.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return rep;
@@ -163,7 +214,11 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
   bool step(State& s, double h, StepReport& rep, std::string* why, bool full_newton = false) {
     Model& sys = *model_;
     rep.chart_switches += sys.rechart(s, hysteresis_);  // between steps only; d, p, v, w unchanged
-    if (h != last_h_) newton_->invalidate_jacobian();
+    if (h != last_h_) {  // K̄ depends on h
+      newton_->invalidate_jacobian();
+      if (replay_kbar_) newton_->resume_after_setup(0);  // a saved K̄ for another h is of no use
+      replay_kbar_ = false;
+    }
     last_h_ = h;
     if (full_newton && !full_newton_) {
       NewtonOptions full = nopt_;
@@ -213,7 +268,16 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
         best_u_ = u;
       }
     };
+    bool replayed = false;
     auto jacobian = [&](const double* up, SparseMatrix& J) {
+      if (replay_kbar_ && !full_newton) {  // first setup after restore(): the saved K̄, not a new one
+        // The uninterrupted run reuses this K̄ from an earlier step here: last_jacobian_iter stays 0.
+        J.values = kbar_;
+        replay_kbar_ = false;
+        replayed = true;
+        return;
+      }
+      last_jacobian_iter = static_cast<int>(history.size());  // used for the iteration that follows
       const Eigen::Map<const Eigen::VectorXd> u(up, n);
       umid_ = 0.5 * (u + un_);
       // Theory §5: em-galpha's symmetric K̄ = (2/Δt²) M(u_mid) + ½ K_mid (+ ξ G), an approximate Jacobian.
@@ -223,7 +287,7 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
       const double cm = 2.0 / (h * h);
       for (size_t k = 0; k < J.values.size(); ++k) J.values[k] = cm * M_.values[k] + 0.5 * K_.values[k];
       apply_dirichlet(sys.dofs(), J, nullptr);
-      last_jacobian_iter = static_cast<int>(history.size());  // used for the iteration that follows
+      if (nopt_.modified && !full_newton) kbar_ = J.values;  // for save()
     };
     auto hook = [&](int k, const double*, const double*, const double*) -> bool {
       const double rk = history.back();
@@ -243,8 +307,9 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
     const NewtonSolver::Result r = newton.solve(u.data(), residual, jacobian, nullptr, nullptr, hook);
     if (full_newton) newton_->invalidate_jacobian();
     rep.nonlinear_iterations += r.iterations;
-    rep.linear_setups += r.jacobian_evals;
-    rep.factorizations += r.factorizations;
+    // A replayed K̄ (restore()) is the uninterrupted run's matrix, not a new setup: not counted.
+    rep.linear_setups += r.jacobian_evals - (replayed ? 1 : 0);
+    rep.factorizations += r.factorizations - (replayed ? 1 : 0);
     rep.rhs_evaluations += r.residual_evals;
     rep.residual_norm = best;
     if (!r.converged) {
@@ -316,6 +381,8 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
   double last_h_ = 0.0;
   long steps_ = 0;
   Data diag_;
+  std::vector<double> kbar_;   // the modified solver's last K̄ (checkpoints)
+  bool replay_kbar_ = false;   // restore(): the next setup of the modified solver uses kbar_
 };
 
 }  // namespace

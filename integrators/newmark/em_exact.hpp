@@ -14,6 +14,8 @@
 //   newton full|modified [full], setup_every [20], linear_solver [eigen-ldlt], res_tol [1e-12],
 //   stall_tol [1e-6], stall_ratio [0.5], max_iters [25], max_cuts [0], hysteresis [1],
 //   correction [true] (false = the paper's force without the §3 correction: for tests that must fail).
+// Checkpoints (docs/architecture.md "Checkpoints and resume"): save/restore continue bitwise, with modified
+// Newton too; a stop request (SIGINT, --max-wall) is honoured at the next step boundary.
 // Stopping (theory §5): the scaled residual ‖r‖∞ / (‖inertia‖∞ + ‖F*‖∞ + ‖F_ext‖∞) ≤ res_tol, or, once it is
 // below stall_tol, an iteration that does not reduce the best residual by stall_ratio (the round-off floor of
 // the co-rotational force); the best iterate is kept.

@@ -16,9 +16,16 @@
 //
 // Settings (case file `integrator:` block or --set key=value):
 //   rho_inf [1], xi [0] (em-galpha), beta [0.25] and gamma [0.5] (newmark),
-//   newton: full|modified [full] (modified: refresh K̄ every setup_every [20] iterations;
-//   a step that fails is retried with full Newton), linear_solver: eigen-ldlt|cholmod|klu [eigen-ldlt],
-//   cc_tol [1e-12; 1e-20 with modified Newton] (paper eq. 39 energy ratio; the paper uses 1e-6), step_tol [1e-14], min_iters [1], max_iters [25],
+//   newton: full|modified [full]. Modified Newton keeps K̄'s factorization over iterations and steps and
+//     refreshes it when the observed contraction θ = ‖Δu_k‖/‖Δu_{k−1}‖ exceeds refresh [0.1] (0: every
+//     setup_every [20] iterations instead); it starts from the Newmark predictor (predictor: none|newmark
+//     [newmark with modified, none with full]; none = u_n as in §6.4) and stops on the first of: the paper's
+//     cc ≤ cc_tol; the energy floor E_k = |Δu_k·P̄(u_{k−1})| ≤ e_floor·(K_0 + V_0 + |W_ext|) (e_floor [1e-20 with
+//     modified, 0 = off with full]; docs/theory.md §6.5); the scaled step test |Δu_i| ≤ step_tol max(1, |u_n,i|)
+//     (round-off reached; step_refresh = true: KINSOL's test instead, which refreshes K̄ and iterates once
+//     more). A step that fails is retried with full Newton. linear_solver: cholmod|eigen-ldlt|klu [cholmod],
+//   cc_tol [1e-12; 1e-14 with modified Newton] (paper eq. 39 energy ratio; the paper uses 1e-6), step_tol [1e-14],
+//   min_iters [1], max_iters [25],
 //   max_cuts [0] (step cutting: a failed step is retried as two half steps, recursively), hysteresis [1].
 #pragma once
 

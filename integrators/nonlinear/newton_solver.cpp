@@ -51,6 +51,8 @@ void validate(const NewtonOptions& o) {
   if (o.stop != StopTest::fnorm && !(o.energy_tol > 0))
     bad("energy_tol must be > 0 when the energy test is used, got " + std::to_string(o.energy_tol));
   if (!(o.energy_floor >= 0)) bad("energy_floor must be >= 0");
+  if (!(o.refresh_contraction >= 0) || !std::isfinite(o.refresh_contraction))
+    bad("refresh_contraction must be >= 0 (0 = off), got " + std::to_string(o.refresh_contraction));
   const auto names = linear_solver_names();
   if (std::find(names.begin(), names.end(), o.linear_solver) == names.end())
     make_linear_solver(o.linear_solver);  // throws with the list of valid names
@@ -190,7 +192,8 @@ const LinearSolver& NewtonSolver::linear_solver() const { return sun_linear_solv
 void NewtonSolver::invalidate_jacobian() { impl_->force_setup = true; }
 int NewtonSolver::iterations_since_setup() const {
   const Impl& s = *impl_;
-  return s.have_jacobian && !s.force_setup ? s.since_setup : -1;
+  // A Jacobian that has served max_setup_calls iterations is refreshed at the next one: nothing to resume.
+  return s.have_jacobian && !s.force_setup && s.since_setup < s.opt.max_setup_calls ? s.since_setup : -1;
 }
 void NewtonSolver::resume_after_setup(int k) { impl_->resume_since_setup = k; }
 
@@ -230,6 +233,7 @@ NewtonSolver::Result NewtonSolver::solve(double* u, const Residual& residual, co
 
   Result r;
   double E0 = 0;
+  double du_norm_prev = 0;  // ‖uscale·Δu_{k−1}‖₂ (contraction-based refresh)
   bool energy_ok = false;  // energy test at the current iterate
   int k = 0;               // iterations done
 
@@ -309,6 +313,21 @@ NewtonSolver::Result NewtonSolver::solve(double* u, const Residual& residual, co
     }
     E = std::abs(E);
     if (first_call) E0 = E;
+    // Observed contraction of the (modified) Newton iteration; a poor one asks for a fresh Jacobian.
+    double du_norm = 0;
+    for (Index i = 0; i < n; ++i) du_norm += (us[i] * s.du[i]) * (us[i] * s.du[i]);
+    du_norm = std::sqrt(du_norm);
+    // At round-off (corrections below ~1e3 ε of the scaled iterate) θ is noise, not a verdict on K̄.
+    double u_norm = 0;
+    for (Index i = 0; i < n; ++i) u_norm += (us[i] * uu[i]) * (us[i] * uu[i]);
+    const bool roundoff = du_norm <= 1e3 * std::numeric_limits<double>::epsilon() * std::max(1.0, std::sqrt(u_norm));
+    if (!first_call && du_norm_prev > 0) {
+      r.contraction = du_norm / du_norm_prev;
+      if (o.modified && o.refresh_contraction > 0 && r.contraction > o.refresh_contraction && !roundoff &&
+          s.jacobian_evals == jac0)  // this iteration used a stale Jacobian
+        s.force_setup = true;
+    }
+    du_norm_prev = du_norm;
     r.energy_ratio = (E0 <= o.energy_floor) ? 0.0 : E / E0;
     // cc = 1 by definition after the first iteration; only the floor can accept there.
     energy_ok = energy_test && r.energy_ratio <= o.energy_tol && (!first_call || E0 <= o.energy_floor);

@@ -77,6 +77,14 @@ struct NewtonOptions {
   StopTest stop = StopTest::fnorm;
   double energy_tol = 1e-6;    // cc threshold of the energy test (paper: 1e-6)
   double energy_floor = 0.0;   // E_0 at or below this -> cc = 0 (absolute floor, §6.5)
+  // Modified Newton only: refresh by observed contraction (0 = off, refresh by max_setup_calls only).
+  // After an iteration whose scaled correction ‖uscale·Δu_k‖₂ did not shrink below refresh_contraction
+  // times the previous one (θ_k = ‖Δu_k‖/‖Δu_{k−1}‖ > refresh_contraction, measured within one solve()),
+  // the next iteration refreshes the Jacobian. With a factorization that is still good θ stays small
+  // (e.g. 1e-3 on a mass-dominated K̄) and the factorization is kept over many steps; it grows as the
+  // tangent drifts away, and is observed rather than guessed by a fixed count. Corrections at round-off
+  // (‖uscale·Δu‖₂ ≤ 1e3 ε max(1, ‖uscale·u‖₂)) never trigger a refresh: their ratio is noise.
+  double refresh_contraction = 0.0;
 };
 
 class NewtonSolver {
@@ -130,6 +138,7 @@ class NewtonSolver {
     int residual_evals = 0;  // real calls of the Residual (cache hits not counted)
     int jacobian_evals = 0;  // calls of the Jacobian = linear-solver setups
     int factorizations = 0;  // numeric factorizations done by the linear solver in this solve()
+    double contraction = 0;  // last observed θ_k = ‖uscale·Δu_k‖₂/‖uscale·Δu_{k−1}‖₂ (0 before k = 2)
     double fnorm = 0;        // ‖fscale·F(u)‖∞ at the returned u (NaN if F failed there)
     double energy_ratio = 1;  // last cc = E_{k-1}/E_0 (1 before the second iteration)
     int kinsol_flag = 0;     // flag of the last KINSol call (see header comment)

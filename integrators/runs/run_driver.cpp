@@ -298,9 +298,12 @@ RunSummary run_dynamic(Problem& problem, const RunOptions& o) {
   const bool files = !o.out_dir.empty();
   const std::string run_json_path = o.out_dir + "/run.json";
   const std::string checkpoint_path = o.out_dir + "/" + checkpoint_file_name();
+  std::unique_ptr<DiskReserve> reserve;  // room for the final run.json on a disk the outputs fill (lib/run_info.hpp)
   if (files) {
     prepare_output_folder(o.out_dir);
     write_run_json(run_json_path, spec, info);
+    reserve = std::make_unique<DiskReserve>(o.out_dir + "/run.json.reserve",
+                                            65536 + 4 * static_cast<long long>(run_json(spec, info).size()));
     std::vector<std::string> names;
     for (const auto& m : monitors) names.push_back(m.name);
     // damping_work: energy dissipated by Rayleigh damping (docs/theory.md §8.5), only for damped models.
@@ -513,12 +516,14 @@ RunSummary run_dynamic(Problem& problem, const RunOptions& o) {
     ++out_index;
   };
 
-  // Writes run.json; if that fails too (full disk), the caller's cause stays the error reported.
-  auto write_status = [&](const std::string& status) -> std::string {
+  // Writes run.json; if that fails too (full disk), the caller's cause stays the error reported. The
+  // final status (`last`) first frees the disk reserve, so that it can be written on a full disk.
+  auto write_status = [&](const std::string& status, bool last) -> std::string {
     sum.status = status;
     sum.wall_seconds = elapsed();
     sum.cpu_seconds = cpu_used();
     if (!files) return {};
+    if (last && reserve) reserve->release();
     info.status = status;
     fill_summary_json(info.summary, sum);
     try {
@@ -578,7 +583,7 @@ RunSummary run_dynamic(Problem& problem, const RunOptions& o) {
         if (line_open) *o.log << std::endl;  // end the in-place status line before the message
         line_open = false;
         const std::string msg = stop_reason + where + resume_hint;
-        const std::string json_error = write_status(msg);
+        const std::string json_error = write_status(msg, true);
         throw RunStopped(msg + (json_error.empty() ? "" : "; " + json_error), stop_code);
       }
       if (k == n_out) break;
@@ -587,7 +592,7 @@ RunSummary run_dynamic(Problem& problem, const RunOptions& o) {
                        (policy.wall > 0.0 && elapsed() >= next_ckpt_wall);
       if (due && can_checkpoint) {
         write_ckpt(next_k);
-        write_status(info.status);  // run.json names the checkpoint
+        write_status(info.status, false);  // run.json names the checkpoint
         if (policy.steps > 0) next_ckpt_step = (sum.totals.steps / policy.steps + 1) * policy.steps;
         if (policy.sim_time > 0.0) next_ckpt_time = (std::floor(state.t / policy.sim_time + 1e-9) + 1.0) * policy.sim_time;
         if (policy.wall > 0.0) next_ckpt_wall = elapsed() + policy.wall;
@@ -597,7 +602,7 @@ RunSummary run_dynamic(Problem& problem, const RunOptions& o) {
     throw;
   } catch (const std::exception& e) {
     if (line_open) *o.log << std::endl;  // end the in-place status line before the error message
-    const std::string json_error = write_status(std::string("incomplete: ") + e.what());
+    const std::string json_error = write_status(std::string("incomplete: ") + e.what(), true);
     if (!json_error.empty()) throw std::runtime_error(std::string(e.what()) + "; " + json_error);
     throw;
   }
@@ -606,7 +611,7 @@ RunSummary run_dynamic(Problem& problem, const RunOptions& o) {
     std::filesystem::remove(checkpoint_path, ec);  // the run is complete: nothing to resume
     info.checkpoint = JsonFields{};
   }
-  const std::string json_error = write_status("complete");
+  const std::string json_error = write_status("complete", true);
   if (!json_error.empty()) throw std::runtime_error(json_error);
   return sum;
 }

@@ -25,6 +25,35 @@ TEST(CR9Algorithmic, ReducesToInternalWhenBothStatesCoincide) {
   }
 }
 
+// The per-step state (w_n, ε_m(t_n), t_n H_m) reproduces the plain overload bitwise: the Model may use
+// either without changing any result. A state of another u_n must not (the test can fail).
+TEST(CR9Algorithmic, StepStateOverloadIsBitwiseTheSame) {
+  for (Shape shape : {Shape::Flat, Shape::Distorted, Shape::Cylinder}) {
+    const Geometry g = make_geometry(shape, Facing::Y);
+    const CR9Shell e(g.X0, g.p0, test_material());
+    Charts ch;
+    const Vec45 un = random_state(g, 0.05, 0.6, 21, &ch);
+    std::mt19937 rng(23);
+    std::uniform_real_distribution<double> U(-1.0, 1.0);
+    Vec45 u1 = un;
+    for (int j = 0; j < 45; ++j) u1(j) += 0.01 * U(rng);
+    CR9Shell::StepState sn, other;
+    e.step_state(un, ch, &sn);
+    e.step_state(u1, ch, &other);
+    for (double xi : {0.0, 0.05}) {
+      Vec45 F, Fs, Fo;
+      Mat45 K, Ks;
+      const double Ua = e.algorithmic_internal(un, u1, ch, 0.5, xi, &F, &K);
+      const double Us = e.algorithmic_internal(sn, un, u1, ch, 0.5, xi, &Fs, &Ks);
+      EXPECT_EQ(Ua, Us);
+      EXPECT_EQ((F - Fs).cwiseAbs().maxCoeff(), 0.0);
+      EXPECT_EQ((K - Ks).cwiseAbs().maxCoeff(), 0.0);
+      e.algorithmic_internal(other, un, u1, ch, 0.5, xi, &Fo, nullptr);
+      EXPECT_GT((F - Fo).norm(), 1e-6 * F.norm());  // a stale state is visible
+    }
+  }
+}
+
 // §6.7(a): with alpha_f = 1/2, xi = 0 the local part is exact (ε quadratic in u_L), but u_L(u_G) is
 // transcendental, so F*·Δu - ΔU = O(Δu³): halving Δu divides the error by ~8.
 TEST(CR9Algorithmic, EnergyBalanceErrorIsThirdOrder) {

@@ -1,7 +1,8 @@
 // Checkpoint/restart (integrators/checkpoint/checkpoint.hpp, Integrator::save/restore,
 // docs/architecture.md "Checkpoints and resume"): file round trip bit for bit, damaged files rejected,
 // the Newmark family continuing bitwise (also after a stop request in the middle of an output interval,
-// and with modified Newton whose K̄ and refresh count must be restored), the SUNDIALS re-initialization
+// and with modified Newton whose K̄ and refresh count must be restored, at every phase of the refresh
+// count), em-exact likewise (with its director velocities State::pdot), the SUNDIALS re-initialization
 // agreeing to its tolerance, and the default of a new integrator.
 #include "baseline_cases.hpp"
 #include "dynamics_fixtures.hpp"
@@ -174,6 +175,8 @@ void expect_bitwise_continuation(const std::string& name, std::vector<std::pair<
   EXPECT_TRUE(same_bits(st.u, ref.u)) << name << ": max |du| = " << (st.u - ref.u).cwiseAbs().maxCoeff();
   EXPECT_TRUE(same_bits(st.v, ref.v)) << name << ": max |dv| = " << (st.v - ref.v).cwiseAbs().maxCoeff();
   EXPECT_TRUE(same_bits(st.a, ref.a)) << name << ": max |da| = " << (st.a - ref.a).cwiseAbs().maxCoeff();
+  EXPECT_TRUE(same_bits(st.pdot, ref.pdot)) << name << ": director velocities differ (sizes " << st.pdot.size() << ", "
+                                            << ref.pdot.size() << ")";
   EXPECT_TRUE(same_bits(integ->external_work(), ref_work));
   for (size_t i = 0; i < st.charts.size(); ++i) EXPECT_EQ(st.charts[i].l, ref.charts[i].l) << "node " << i;
   EXPECT_EQ(rep_b.steps, ref_rep.steps);
@@ -187,10 +190,33 @@ TEST(CheckpointNewmark, EmGalphaModifiedNewtonContinuesBitwise) {
   expect_bitwise_continuation("em-galpha", {{"newton", "modified"}, {"setup_every", "3"}}, 7);
   expect_bitwise_continuation("em-galpha", {{"newton", "modified"}, {"setup_every", "3"}}, 1);
 }
+TEST(CheckpointNewmark, EmGalphaModifiedNewtonDefaultsContinueBitwise) {
+  // The modified-Newton defaults: K̄ kept across steps and refreshed by observed contraction, Newmark
+  // predictor, energy floor e_floor·(K_0 + V_0 + |W_ext|) whose K_0 + V_0 (taken at initialize()) must come
+  // from the checkpoint, not from the state the resumed integrator was initialized with.
+  expect_bitwise_continuation("em-galpha", {{"newton", "modified"}}, 7);
+  expect_bitwise_continuation("em-galpha", {{"newton", "modified"}}, 1);
+  // cc_tol out of reach: the energy floor (or the step test) ends every iteration.
+  expect_bitwise_continuation("em-galpha", {{"newton", "modified"}, {"cc_tol", "1e-30"}}, 7);
+}
 TEST(CheckpointNewmark, EmGalphaFullNewtonContinuesBitwise) { expect_bitwise_continuation("em-galpha", {}, 5); }
 TEST(CheckpointNewmark, GalphaContinuesBitwise) { expect_bitwise_continuation("galpha", {{"rho_inf", "0.8"}}, 5); }
 TEST(CheckpointNewmark, MidpointContinuesBitwise) { expect_bitwise_continuation("midpoint", {}, 5); }
 TEST(CheckpointNewmark, NewmarkContinuesBitwise) { expect_bitwise_continuation("newmark", {}, 5); }
+TEST(CheckpointNewmark, EmGalphaModifiedNewtonAtEveryRefreshPhase) {
+  // Cut after 1..6 steps: among them the cuts where the saved K̄ has used up its setup_every iterations
+  // (the next iteration refreshes it; replaying it would be wrong).
+  for (int stop_after = 1; stop_after <= 6; ++stop_after)
+    expect_bitwise_continuation("em-galpha", {{"newton", "modified"}, {"setup_every", "2"}}, stop_after);
+}
+
+// em-exact carries the embedded director velocities (State::pdot) and its own diagnostics.
+TEST(CheckpointEmExact, FullNewtonContinuesBitwise) { expect_bitwise_continuation("em-exact", {}, 5); }
+TEST(CheckpointEmExact, DissipativeContinuesBitwise) { expect_bitwise_continuation("em-exact", {{"rho_inf", "0.8"}, {"max_cuts", "3"}}, 3); }
+TEST(CheckpointEmExact, ModifiedNewtonContinuesBitwiseAtEveryRefreshPhase) {
+  for (int stop_after = 1; stop_after <= 6; ++stop_after)
+    expect_bitwise_continuation("em-exact", {{"newton", "modified"}, {"setup_every", "2"}}, stop_after);
+}
 
 // ida-bdf restarts from the saved state (re-initialization): not bitwise; the continued run must agree
 // with the uninterrupted one to the level of its tolerances. Measured: see the bound below.

@@ -171,6 +171,38 @@ TEST(NewtonSolver, ModifiedNewtonUsesFewerFactorizationsAndMoreIterations) {
   EXPECT_EQ(mod.linear_solver().stats().analyses, 1);
 }
 
+TEST(NewtonSolver, ContractionBasedRefreshKeepsAGoodFactorizationAndReplacesAPoorOne) {
+  // Bratu from u = 0: the Jacobian at u = 0 is a poor model of the one at the solution (θ ≈ 0.3 - 0.5),
+  // so a contraction threshold of 0.1 must refresh it, while a threshold of 0.9 keeps it.
+  const Bratu b(24, 6.0);
+  auto run = [&](double threshold, NewtonSolver::Result* out) {
+    NewtonOptions o;
+    o.modified = true;
+    o.max_setup_calls = 1000000;  // no refresh by count
+    o.refresh_contraction = threshold;
+    o.max_iters = 200;
+    NewtonSolver solver(b.pattern, o);
+    std::vector<double> u(b.n(), 0.0);
+    *out = solver.solve(u.data(), b.F(), b.J());
+    EXPECT_TRUE(out->converged) << out->message;
+    EXPECT_LE(b.max_residual(u), 1e-10);
+  };
+  NewtonSolver::Result loose, tight;
+  run(0.9, &loose);
+  run(0.1, &tight);
+  std::printf("[ info ] contraction refresh 0.9: %d iterations / %d factorizations (last theta %.2g); 0.1: %d / %d\n",
+              loose.iterations, loose.factorizations, loose.contraction, tight.iterations, tight.factorizations);
+  EXPECT_EQ(loose.factorizations, 1);           // never refreshed: θ stayed below 0.9
+  EXPECT_GT(loose.contraction, 0.1);            // ... but above 0.1, so the tight run must refresh
+  EXPECT_GE(tight.factorizations, 2);
+  EXPECT_LT(tight.iterations, loose.iterations);
+  // With refresh by contraction off and no count, the first factorization is used throughout.
+  NewtonSolver::Result off;
+  run(0.0, &off);
+  EXPECT_EQ(off.factorizations, 1);
+  EXPECT_EQ(off.iterations, loose.iterations);
+}
+
 TEST(NewtonSolver, LineSearchVariantConverges) {
   const Bratu b(24, 6.0);
   NewtonOptions o;
@@ -369,6 +401,9 @@ TEST(NewtonSolver, RejectsBadOptions) {
   EXPECT_THROW(NewtonSolver(b.pattern, o), std::invalid_argument);
   o = NewtonOptions{};
   o.max_iters = 0;
+  EXPECT_THROW(NewtonSolver(b.pattern, o), std::invalid_argument);
+  o = NewtonOptions{};
+  o.refresh_contraction = -0.1;
   EXPECT_THROW(NewtonSolver(b.pattern, o), std::invalid_argument);
   EXPECT_THROW(NewtonSolver(nullptr), std::invalid_argument);
   NewtonSolver s(b.pattern);

@@ -7,6 +7,8 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Sparse>
+#include <dirent.h>
+#include <omp.h>
 
 #include <algorithm>
 #include <cmath>
@@ -180,6 +182,35 @@ TEST(LinearSolver, SpdMatrixKeepsCholmodSupernodal) {
   auto s = make_linear_solver("cholmod");
   s->factorize(A.view());
   EXPECT_EQ(s->stats().analyses, 1);  // no fallback re-analysis
+}
+
+// No hidden threads: CHOLMOD's supernodal kernels open OpenMP regions with a fixed num_threads(4) and
+// OpenBLAS starts its own pool (lib/linear_solver.cpp). With one OpenMP thread requested, factorizing and
+// solving must not add a single thread to the process (counted in /proc/self/task). The matrix is large
+// enough (16 x 16 elements, 5445 unknowns) for supernodes wider than CHOLMOD's 32-column threshold.
+int process_threads() {
+  int n = 0;
+  if (DIR* d = opendir("/proc/self/task")) {
+    while (const dirent* e = readdir(d))
+      if (e->d_name[0] != '.') ++n;
+    closedir(d);
+  }
+  return n;
+}
+
+TEST(LinearSolver, CholmodStartsNoHiddenThreads) {
+  if (process_threads() == 0) GTEST_SKIP() << "no /proc/self/task on this system";
+  omp_set_num_threads(1);
+  const SparseMatrix A = shell_like_matrix(16, 11);
+  const int before = process_threads();
+  auto s = make_linear_solver("cholmod");
+  s->factorize(A.view());
+  s->factorize(A.view());
+  const std::vector<double> b = random_vector(A.pattern->n, 12);
+  std::vector<double> x(b.size());
+  s->solve(b.data(), x.data());
+  EXPECT_LT(relative_residual(A.view(), x, b), 1e-12);
+  EXPECT_EQ(process_threads(), before) << "CHOLMOD or its BLAS started threads beyond --threads";
 }
 
 // A singular matrix (a zero row/column) must throw naming the back-end and the column.

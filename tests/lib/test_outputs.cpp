@@ -8,6 +8,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <limits>
 #include <sstream>
 
@@ -226,3 +227,67 @@ TEST(RunInfo, DocumentHasStatusVersionsCaseAndSummary) {
 }
 
 }  // namespace
+
+// A full disk without root: /dev/full accepts open() and fails every write with ENOSPC. A file the
+// writers create is made a symbolic link to it; each writer must say "the disk is full", name the file
+// it was writing, and leave no temporary or half-written file behind.
+namespace {
+bool have_dev_full() { return fs::exists("/dev/full"); }
+
+std::string error_of(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const std::exception& e) {
+    return e.what();
+  }
+  return "(no error)";
+}
+}  // namespace
+
+TEST(DiskFull, RunJsonSaysSoAndLeavesNoTemporary) {
+  if (!have_dev_full()) GTEST_SKIP() << "no /dev/full";
+  const fs::path dir = scratch_dir("full_runjson");
+  fs::create_symlink("/dev/full", dir / "run.json.tmp");
+  const std::string e = error_of([&] { write_text_atomically((dir / "run.json").string(), std::string(10000, 'x'), "run.json"); });
+  EXPECT_NE(e.find((dir / "run.json").string() + ": cannot write run.json: the disk is full"), std::string::npos) << e;
+  EXPECT_FALSE(fs::exists(fs::symlink_status(dir / "run.json.tmp"))) << "a stale run.json.tmp was left";
+  EXPECT_FALSE(fs::exists(dir / "run.json"));
+}
+
+TEST(DiskFull, VtuSaysSoAndLeavesNoFile) {
+  if (!have_dev_full()) GTEST_SKIP() << "no /dev/full";
+  const fs::path dir = scratch_dir("full_vtu");
+  const Mesh mesh = two_element_mesh();
+  VtuFields f;
+  f.displacement = f.velocity = f.director = std::vector<Vec3>(mesh.X.size(), Vec3(0.5, 0.25, 1.0));
+  fs::create_symlink("/dev/full", dir / "step_000003.vtu");
+  const std::string e = error_of([&] { write_vtu((dir / "step_000003.vtu").string(), mesh, f); });
+  EXPECT_NE(e.find((dir / "step_000003.vtu").string() + ": cannot write: the disk is full"), std::string::npos) << e;
+  EXPECT_FALSE(fs::exists(fs::symlink_status(dir / "step_000003.vtu"))) << "a half-written VTU was left";
+}
+
+TEST(DiskFull, HistorySaysSo) {
+  if (!have_dev_full()) GTEST_SKIP() << "no /dev/full";
+  const fs::path dir = scratch_dir("full_history");
+  fs::create_symlink("/dev/full", dir / "history.csv");
+  const std::string e = error_of([&] { HistoryWriter w((dir / "history.csv").string(), {}, {"tip"}); });
+  EXPECT_NE(e.find((dir / "history.csv").string() + ": cannot write history.csv: the disk is full"), std::string::npos) << e;
+}
+
+TEST(DiskReserve, HoldsTheSpaceUntilReleased) {
+  const fs::path dir = scratch_dir("reserve");
+  const fs::path p = dir / "run.json.reserve";
+  {
+    DiskReserve r(p.string(), 65536);
+    ASSERT_TRUE(r.held());
+    ASSERT_TRUE(fs::exists(p));
+    EXPECT_EQ(fs::file_size(p), 65536u);
+    r.release();
+    EXPECT_FALSE(r.held());
+    EXPECT_FALSE(fs::exists(p));
+  }
+  { DiskReserve r(p.string(), 4096); }
+  EXPECT_FALSE(fs::exists(p)) << "the destructor must delete the reserve";
+  DiskReserve none((dir / "no-such-folder" / "x").string(), 4096);
+  EXPECT_FALSE(none.held());
+}
