@@ -80,31 +80,6 @@ std::string settings_text(const std::vector<std::pair<std::string, std::string>>
   return out;
 }
 
-// max_t ‖m(t) − m_ref(t)‖₂ over the shared output times; NaN if none is shared.
-double monitor_distance(const CsvTable& a, const CsvTable& b, const std::vector<std::string>& monitors) {
-  const auto* ta = a.column("t");
-  const auto* tb = b.column("t");
-  if (!ta || !tb || monitors.empty()) return std::nan("");
-  std::vector<const std::vector<double>*> ca, cb;
-  for (const auto& m : monitors) {
-    ca.push_back(a.column(m));
-    cb.push_back(b.column(m));
-    if (!ca.back() || !cb.back()) return std::nan("");
-  }
-  double worst = -1.0;
-  size_t j = 0;
-  for (size_t i = 0; i < ta->size(); ++i) {
-    const double t = (*ta)[i], tol = 1e-9 * std::max(1.0, std::abs(t));
-    while (j < tb->size() && (*tb)[j] < t - tol) ++j;
-    if (j == tb->size()) break;
-    if (std::abs((*tb)[j] - t) > tol) continue;
-    double d2 = 0.0;
-    for (size_t k = 0; k < monitors.size(); ++k) d2 += std::pow((*ca[k])[i] - (*cb[k])[j], 2);
-    worst = std::max(worst, std::sqrt(d2));
-  }
-  return worst < 0.0 ? std::nan("") : worst;
-}
-
 }  // namespace
 
 const std::vector<double>* CsvTable::column(const std::string& name) const {
@@ -138,6 +113,30 @@ CsvTable read_csv_table(const std::string& path) {
     for (size_t c = 0; c < values.size(); ++c) t.data[c].push_back(values[c]);
   }
   return t;
+}
+
+double monitor_distance(const CsvTable& a, const CsvTable& b, const std::vector<std::string>& monitors) {
+  const auto* ta = a.column("t");
+  const auto* tb = b.column("t");
+  if (!ta || !tb || monitors.empty()) return std::nan("");
+  std::vector<const std::vector<double>*> ca, cb;
+  for (const auto& m : monitors) {
+    ca.push_back(a.column(m));
+    cb.push_back(b.column(m));
+    if (!ca.back() || !cb.back()) return std::nan("");
+  }
+  double worst = -1.0;
+  size_t j = 0;
+  for (size_t i = 0; i < ta->size(); ++i) {
+    const double t = (*ta)[i], tol = 1e-9 * std::max(1.0, std::abs(t));
+    while (j < tb->size() && (*tb)[j] < t - tol) ++j;
+    if (j == tb->size()) break;
+    if (std::abs((*tb)[j] - t) > tol) continue;
+    double d2 = 0.0;
+    for (size_t k = 0; k < monitors.size(); ++k) d2 += std::pow((*ca[k])[i] - (*cb[k])[j], 2);
+    worst = std::max(worst, std::sqrt(d2));
+  }
+  return worst < 0.0 ? std::nan("") : worst;
 }
 
 double mechanical_energy_drift(const CsvTable& h, double loads_end) {

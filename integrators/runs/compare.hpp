@@ -124,4 +124,8 @@ CsvTable read_csv_table(const std::string& path);
 // cases alike. NaN if no output time is at or after loads_end or K + V = 0 there.
 double mechanical_energy_drift(const CsvTable& history, double loads_end);
 
+// max_t ‖m(t) − m_ref(t)‖₂ over the output times both histories share, m = the named monitor columns
+// (the displacement error of compare and study); NaN if no time is shared or a column is missing.
+double monitor_distance(const CsvTable& a, const CsvTable& b, const std::vector<std::string>& monitors);
+
 }  // namespace shelldyn

@@ -33,31 +33,6 @@ std::string read_text(const std::string& path) {
   return ss.str();
 }
 
-// max over the output times both tables share of ‖m(t) − m_ref(t)‖₂ (monitor columns); NaN if none shared.
-double monitor_distance(const CsvTable& a, const CsvTable& b, const std::vector<std::string>& monitors) {
-  const auto* ta = a.column("t");
-  const auto* tb = b.column("t");
-  if (!ta || !tb || monitors.empty()) return NaN;
-  std::vector<const std::vector<double>*> ca, cb;
-  for (const auto& m : monitors) {
-    ca.push_back(a.column(m));
-    cb.push_back(b.column(m));
-    if (!ca.back() || !cb.back()) return NaN;
-  }
-  double worst = -1.0;
-  size_t j = 0;
-  for (size_t i = 0; i < ta->size(); ++i) {
-    const double t = (*ta)[i], tol = 1e-9 * std::max(1.0, std::abs(t));
-    while (j < tb->size() && (*tb)[j] < t - tol) ++j;
-    if (j == tb->size()) break;
-    if (std::abs((*tb)[j] - t) > tol) continue;
-    double d2 = 0.0;
-    for (size_t k = 0; k < monitors.size(); ++k) d2 += std::pow((*ca[k])[i] - (*cb[k])[j], 2);
-    worst = std::max(worst, std::sqrt(d2));
-  }
-  return worst < 0.0 ? NaN : worst;
-}
-
 // Energy-balance error of a history: max_t |H(t) − H(t₀)| / max_t (K + V)(t), H = K + V − W_ext. The exact
 // flow keeps H constant with the loads on as well (W_ext is the work done on the body), so this measures
 // every integrator on windows that end before the loads do.
