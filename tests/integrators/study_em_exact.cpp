@@ -57,7 +57,7 @@ Long long_run(Model& model, State s, const std::string& name, double dt, double 
   return r;
 }
 
-// spec/element.md §7.12 plate, 20 s.
+// The free plate of docs/theory.md §7 item 12, 20 s.
 TEST(EmExactStudy, DISABLED_FreePlate20s) {
   for (double dt : {0.02, 0.01, 0.005})
     for (const char* name : {"em-exact", "em-galpha"}) {
