@@ -75,7 +75,7 @@ struct CheckOptions {
   std::string out_dir;  // empty: results/<case name>
   std::string command;  // the full command line, recorded in run.json
   bool overwrite = false;
-  std::string state_file;  // static: start from this checkpoint (or run folder holding one)
+  std::string state_file;  // static: start from this checkpoint (or run folder holding one) or run VTU
 };
 
 void print_summary(std::ostream& out, const CaseSpec& c, const Discretization& d) {
@@ -154,7 +154,14 @@ VtuFields initial_fields(const Discretization& d) {
   for (Index dof : d.dofs.constrained_dofs()) fixed.values[static_cast<size_t>(dof / kDofsPerNode)] += 1.0;
   ScalarField load{"load_magnitude", std::vector<double>(n, 0.0)};
   for (const auto& l : d.loads) load.values[static_cast<size_t>(l.node)] += l.vector.norm();
-  f.point_scalars = {std::move(fixed), std::move(load)};
+  // Director rate ṗ = A1(q0) q̇ (as state_fields writes it), so this VTU can serve as a velocity field.
+  ScalarField pdot{"director_rate", std::vector<double>(3 * n, 0.0), 3};
+  for (size_t i = 0; i < n; ++i) {
+    const Eigen::Index k = static_cast<Eigen::Index>(DofMap::dof(static_cast<int>(i), 3));
+    const Vec3 w = director_A1(chart_coordinates(d.normals[i], d.charts[i]), d.charts[i]) * d.initial_velocity.segment<2>(k);
+    for (size_t c = 0; c < 3; ++c) pdot.values[3 * i + c] = w[static_cast<Eigen::Index>(c)];
+  }
+  f.point_scalars = {std::move(pdot), std::move(fixed), std::move(load)};
   return f;
 }
 
@@ -362,19 +369,8 @@ int run_static_command(const CheckOptions& o) {
   // --state: the configuration of a saved run (its checkpoint) as the starting point, its time as λ₀.
   std::unique_ptr<State> start;
   if (!o.state_file.empty()) {
-    std::string path = o.state_file;
-    if (fs::is_directory(path)) path = (fs::path(path) / checkpoint_file_name()).string();
-    if (!fs::exists(path))
-      throw std::invalid_argument("--state " + path + ": no such file (give a checkpoint.cbor, or the folder of a run "
-                                  "that wrote one: shelldyn run --checkpoint-every ...)");
-    Checkpoint c = read_checkpoint(path);
-    if (c.state.u.size() != problem.model->num_dofs() ||
-        static_cast<int>(c.state.charts.size()) != problem.model->mesh().num_nodes())
-      throw std::invalid_argument("--state " + path + ": the checkpoint holds " + std::to_string(c.state.u.size()) +
-                                  " DOFs, this case's model " + std::to_string(problem.model->num_dofs()) +
-                                  " (a checkpoint of another case or mesh?)");
-    start = std::make_unique<State>(c.state);
-    std::cout << "starting from " << path << " (t = " << c.state.t << ") at load factor " << c.state.t << std::endl;
+    start = std::make_unique<State>(app::load_saved_state(problem, o.state_file));
+    std::cout << "starting from " << o.state_file << " at load factor " << start->t << std::endl;
   }
   StaticReport report;
   const auto rows = run_static(problem, dir, &std::cout, &report, start.get());
@@ -400,8 +396,8 @@ void add_static_command(CLI::App& app, Action& action, const std::string& comman
   sub->add_option("-o,--output", opts->out_dir, "Result folder (default: results/<case>/static)");
   sub->add_flag("--overwrite", opts->overwrite, "Replace the results of an earlier command in the result folder");
   sub->add_option("--state", opts->state_file,
-                  "Start from a saved state: a checkpoint.cbor of `shelldyn run` (or its run folder); its time is the "
-                  "starting load factor, velocities are ignored (default: the reference state at load factor 0)");
+                  "Start from a saved state: a checkpoint.cbor of `shelldyn run` (or its run folder), or a VTU of a run "
+                  "(DIR/fields/step_N.vtu, its time from DIR/fields.pvd); its time is the starting load factor, velocities are ignored (default: the reference state at load factor 0)");
   sub->callback([opts, &action] { action = [opts] { return run_static_command(*opts); }; });
 }
 
