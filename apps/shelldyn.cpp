@@ -505,10 +505,12 @@ void add_compare_command(CLI::App& app, Action& action, const std::string& comma
 // --- study -------------------------------------------------------------------------------------------
 // `shelldyn study BENCHMARK`: the integrator study of integrators/runs/study.hpp (work–precision sweep on a
 // window + full-duration conservation runs, resumable), then scripts/plot_study.py. Exit 0 when every run
-// completed, 3 when some failed, 1 for bad input.
+// completed or stopped at the per-run budget, 3 when some failed, 1 for bad input.
 struct StudyCommandOptions {
   std::string benchmark, case_path, out_dir, command, only = "all";
   int jobs = 2;
+  double max_wall_per_run = 0.0;
+  long long max_steps_per_run = 0;
   bool rerun = false, dry_run = false, no_plots = false;
 };
 
@@ -522,6 +524,10 @@ int run_study_command(const StudyCommandOptions& o) {
   else if (o.only != "all")
     throw std::invalid_argument("--only must be window, full or all (got '" + o.only + "')");
   so.out_dir = o.out_dir.empty() ? (fs::path("results") / o.benchmark / "study").string() : o.out_dir;
+  if (!(o.max_wall_per_run >= 0.0) || !std::isfinite(o.max_wall_per_run) || o.max_steps_per_run < 0)
+    throw std::invalid_argument("--max-wall-per-run and --max-steps-per-run must be >= 0 (0: no budget)");
+  so.max_wall_per_run = o.max_wall_per_run;
+  so.max_steps_per_run = o.max_steps_per_run;
   so.rerun = o.rerun;
   so.dry_run = o.dry_run;
   so.execution.jobs = o.jobs;
@@ -535,8 +541,8 @@ int run_study_command(const StudyCommandOptions& o) {
   if (!so.report) so.log = nullptr;
   const StudyResult r = run_study(so);
   if (o.dry_run || !so.report) return 0;
-  std::cout << "study " << o.benchmark << ": " << r.ran << " runs made, " << r.skipped << " already complete, " << r.failed
-            << " failed; wrote " << r.study_csv << ", " << r.study_md << std::endl;
+  std::cout << "study " << o.benchmark << ": " << r.ran << " runs made, " << r.skipped << " kept from earlier, " << r.stopped
+            << " stopped at the per-run budget, " << r.failed << " failed; wrote " << r.study_csv << ", " << r.study_md << std::endl;
   if (!o.no_plots && app::run_python_script(app::find_script("plot_study.py"), {so.out_dir}, std::cout))
     std::cout << "wrote " << so.out_dir << "/work_precision.png, full_energy.png, full_momentum.png" << std::endl;
   return r.failed ? 3 : 0;
@@ -555,6 +561,11 @@ void add_study_command(CLI::App& app, Action& action, const std::string& command
   sub->add_option("-o,--output", o->out_dir, "Result folder (default: results/<benchmark>/study)");
   sub->add_option("--jobs", o->jobs, "Runs at a time, each single-threaded (default 2)");
   sub->add_option("--only", o->only, "Run only the group window (work-precision sweep) or full (full duration); default all");
+  sub->add_option("--max-wall-per-run", o->max_wall_per_run,
+                  "Budget per run in wall seconds (default 0: none); a run that hits it is reported as stopped at budget "
+                  "with the time reached, never as complete");
+  sub->add_option("--max-steps-per-run", o->max_steps_per_run,
+                  "Budget per run in steps, checked at output times (default 0: none); reported as --max-wall-per-run");
   sub->add_flag("--rerun", o->rerun, "Run completed runs again (default: keep them; the study resumes)");
   sub->add_flag("--dry-run", o->dry_run, "List the runs and which are complete; run nothing");
   sub->add_flag("--no-plots", o->no_plots, "Do not call scripts/plot_study.py");
