@@ -329,6 +329,10 @@ int run_resume(const RunCommandOptions& o) {
   check_run_flags(o);
   const std::string dir = o.case_path;
   const Checkpoint c = read_checkpoint((fs::path(dir) / checkpoint_file_name()).string());
+  // A run killed with SIGKILL leaves its disk reserve (lib/run_info.hpp DiskReserve) behind: stale, remove it
+  // (the resumed run allocates its own and deletes it at the end, whatever the outcome).
+  std::error_code ec;
+  fs::remove(fs::path(dir) / "run.json.reserve", ec);
   Problem problem = problem_from_checkpoint(c);
   RunOptions ro = run_options_from_checkpoint(c);
   ro.out_dir = dir;
