@@ -239,9 +239,9 @@ StudyResult run_study(const StudyOptions& o) {
       }
     }
     say("study " + p.name + " / " + group + ": " + std::to_string(runs.size()) + " runs, " +
-        std::to_string(runs.size() - pending.size()) + " already complete, " + std::to_string(pending.size()) + " to run -> " +
-        co.out_dir);
-    if (o.dry_run || pending.empty()) continue;
+        std::to_string(runs.size() - pending.size()) + " already complete, " + std::to_string(pending.size()) +
+        (o.report_only ? " not run (report only)" : " to run") + " -> " + co.out_dir);
+    if (o.dry_run || o.report_only || pending.empty()) continue;
     co.specs = pending;
     const CompareResult cr = run_comparison(co);
     result.ran += static_cast<int>(cr.rows.size());
@@ -276,6 +276,8 @@ StudyResult run_study(const StudyOptions& o) {
       const fs::path dir = fs::path(o.out_dir) / group / label;
       const std::string json = read_text((dir / "run.json").string());
       row.status = json.empty() ? "not run" : run_json_status(json);
+      // run.json still says "running": the study was stopped (killed) during this run; it has no result.
+      if (row.status.rfind("incomplete: running", 0) == 0) row.status = "not run (the study was stopped during this run)";
       if (row.status.rfind("incomplete", 0) == 0) row.status = "failed: " + row.status.substr(std::min<size_t>(12, row.status.size()));
       if (!stopped_budget(row.status).first.empty()) {
         // Stopped at the per-run budget: what it cost and how far it got; no error measures (they would
@@ -320,7 +322,7 @@ StudyResult run_study(const StudyOptions& o) {
         } catch (const std::exception& e) {
           row.status = std::string("failed: history unreadable: ") + e.what();
         }
-      } else if (row.status != "not run") {
+      } else if (row.status.rfind("not run", 0) != 0) {
         ++result.failed;
       }
       result.rows.push_back(row);
