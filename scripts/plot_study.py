@@ -129,10 +129,10 @@ def main():
         w_stopped = [r for r in stopped if r["group"] == "window"]
         if w_stopped:
             names = ", ".join(r["label"] for r in w_stopped)
-            if len(names) > 150:
-                names = names[:147] + "..."
-            fig.text(0.5, 0.005, f"not plotted: {len(w_stopped)} run(s) stopped at the per-run budget before the "
-                     f"window's end (study.md): {names}", ha="center", va="bottom", fontsize=8.5, color="0.3")
+            if len(names) > 110:  # keep the line inside the figure; study.md lists every run
+                names = names[:107] + "..."
+            fig.text(0.5, 0.005, f"not plotted: {len(w_stopped)} run(s) stopped at the per-run budget (study.md): {names}",
+                     ha="center", va="bottom", fontsize=8.5, color="0.3")
         t_end = max(fnum(r["t_end"]) for r in window)
         fig.suptitle(f"{title}: work–precision on 0 ≤ t ≤ {t_end:g} s (lower left is better)", fontsize=13)
         fig.tight_layout(rect=(0, 0.1, 1, 0.96))
