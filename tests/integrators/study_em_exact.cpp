@@ -96,10 +96,14 @@ TEST(EmExactStudy, DISABLED_TumblingPlate200sDt002) {
 TEST(EmExactStudy, DISABLED_SpinR1200s) {
   const Long r = spin({0, 0, 1}, 0.01, "R1 200 s");
   EXPECT_LT(r.max_strain, 1e-6);
+  EXPECT_LT(r.max_dH, 1e-10);
+  EXPECT_LT(r.max_dJ, 1e-9);
 }
 TEST(EmExactStudy, DISABLED_SpinR2200s) {
   const Long r = spin({1, 0, 0}, 0.01, "R2 200 s");
   EXPECT_LT(r.max_strain, 1e-6);
+  EXPECT_LT(r.max_dH, 1e-10);
+  EXPECT_LT(r.max_dJ, 1e-9);
 }
 
 }  // namespace
