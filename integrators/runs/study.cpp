@@ -279,12 +279,8 @@ StudyResult run_study(const StudyOptions& o) {
       // run.json still says "running": the study was stopped (killed) during this run; it has no result.
       if (row.status.rfind("incomplete: running", 0) == 0) row.status = "not run (the study was stopped during this run)";
       if (row.status.rfind("incomplete", 0) == 0) row.status = "failed: " + row.status.substr(std::min<size_t>(12, row.status.size()));
-      if (!stopped_budget(row.status).first.empty()) {
-        // Stopped at the per-run budget: what it cost and how far it got; no error measures (they would
-        // cover part of the window only).
-        row.stop_note = row.status.substr(0, row.status.find(" at t = "));
-        row.status = "stopped at budget";
-        ++result.stopped;
+      // Cost of a run that ran (complete or stopped at its budget), from its run.json.
+      auto read_cost = [&] {
         row.steps = static_cast<long>(run_json_number(json, "steps"));
         row.rhs_evaluations = static_cast<long>(run_json_number(json, "rhs_evaluations"));
         row.factorizations = static_cast<long>(run_json_number(json, "factorizations"));
@@ -292,6 +288,14 @@ StudyResult run_study(const StudyOptions& o) {
         row.cpu_s = run_json_number(json, "cpu_s");
         row.wall_s = run_json_number(json, "wall_s");
         row.t_end = run_json_number(json, "t_end");
+      };
+      if (!stopped_budget(row.status).first.empty()) {
+        // Stopped at the per-run budget: what it cost and how far it got; no error measures (they would
+        // cover part of the window only).
+        row.stop_note = row.status.substr(0, row.status.find(" at t = "));
+        row.status = "stopped at budget";
+        ++result.stopped;
+        read_cost();
         try {
           const CsvTable h = read_csv_table((dir / "history.csv").string());
           const auto* t = h.column("t");
@@ -300,13 +304,7 @@ StudyResult run_study(const StudyOptions& o) {
           row.t_reached = NaN;
         }
       } else if (row.status == "complete") {
-        row.steps = static_cast<long>(run_json_number(json, "steps"));
-        row.rhs_evaluations = static_cast<long>(run_json_number(json, "rhs_evaluations"));
-        row.factorizations = static_cast<long>(run_json_number(json, "factorizations"));
-        row.nonlinear_iterations = static_cast<long>(run_json_number(json, "nonlinear_iterations"));
-        row.cpu_s = run_json_number(json, "cpu_s");
-        row.wall_s = run_json_number(json, "wall_s");
-        row.t_end = run_json_number(json, "t_end");
+        read_cost();
         row.t_reached = row.t_end;
         row.max_dL = run_json_number(json, "max_abs_dL_after_loads");
         row.max_dJ = run_json_number(json, "max_abs_dJ_after_loads");
