@@ -36,6 +36,16 @@ def rows(path):
         return list(csv.DictReader(f))
 
 
+def run_case(exe, work, name, text):
+    """Writes the case WORK/NAME.yaml and runs it quietly into WORK/NAME; returns that folder."""
+    case = os.path.join(work, name + ".yaml")
+    with open(case, "w") as f:
+        f.write(text)
+    out = os.path.join(work, name)
+    run([exe, "run", case, "-q", "-o", out])
+    return out
+
+
 def modes_table(path):
     return [float(r["omega_rad_s"]) for r in rows(path)]
 
@@ -90,15 +100,11 @@ monitors:
   - {name: uz_max, set: all, quantity: uz, reduce: max}
   - {name: pz_min, set: all, quantity: pz, reduce: min}
 """
-    case_a = os.path.join(work, "tumbling_a.yaml")
-    open(case_a, "w").write(plate + "initial_velocity: {translation: [0.1, 0, 0.3], angular: [0.4, 1.0, 0.2]}\n")
-    run_a = os.path.join(work, "tumbling_a")
-    run([exe, "run", case_a, "-q", "-o", run_a])
+    run_a = run_case(exe, work, "tumbling_a",
+                     plate + "initial_velocity: {translation: [0.1, 0, 0.3], angular: [0.4, 1.0, 0.2]}\n")
     step0 = os.path.abspath(os.path.join(run_a, "fields", "step_000000.vtu"))
-    case_b = os.path.join(work, "tumbling_b.yaml")
-    open(case_b, "w").write(plate.replace("name: tumbling", "name: tumbling-b") + f"initial_velocity: {{field: {step0}}}\n")
-    run_b = os.path.join(work, "tumbling_b")
-    run([exe, "run", case_b, "-q", "-o", run_b])
+    run_b = run_case(exe, work, "tumbling_b",
+                     plate.replace("name: tumbling", "name: tumbling-b") + f"initial_velocity: {{field: {step0}}}\n")
     ha, hb = rows(os.path.join(run_a, "history.csv")), rows(os.path.join(run_b, "history.csv"))
     if len(ha) != 21 or len(hb) != len(ha):
         fail(f"history rows: {len(ha)} and {len(hb)}, expected 21")
@@ -121,16 +127,11 @@ integrator: {name: em-galpha}
 time: {dt: 0.01, t_end: 0.2, output_interval: 0.01}
 output: {vtu_every: 1}
 """
-    case_c = os.path.join(work, "strip_c.yaml")
-    open(case_c, "w").write(strip + "initial_velocity: {set: right, translation: [0, 0, 2]}\n")
-    run_c = os.path.join(work, "strip_c")
-    run([exe, "run", case_c, "-q", "-o", run_c])
+    run_c = run_case(exe, work, "strip_c", strip + "initial_velocity: {set: right, translation: [0, 0, 2]}\n")
     mid = os.path.abspath(os.path.join(run_c, "fields", "step_000010.vtu"))
-    case_d = os.path.join(work, "strip_d.yaml")
-    open(case_d, "w").write(strip.replace("name: strip", "name: strip-d").replace("t_end: 0.2", "t_end: 0.1")
-                            + f"initial_displacement: {{field: {mid}}}\ninitial_velocity: {{field: {mid}}}\n")
-    run_d = os.path.join(work, "strip_d")
-    run([exe, "run", case_d, "-q", "-o", run_d])
+    run_d = run_case(exe, work, "strip_d",
+                     strip.replace("name: strip", "name: strip-d").replace("t_end: 0.2", "t_end: 0.1")
+                     + f"initial_displacement: {{field: {mid}}}\ninitial_velocity: {{field: {mid}}}\n")
     hc, hd = rows(os.path.join(run_c, "history.csv")), rows(os.path.join(run_d, "history.csv"))
     at = [r for r in hc if abs(float(r["t"]) - 0.1) < 1e-9]
     if len(at) != 1:

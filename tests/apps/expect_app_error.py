@@ -8,8 +8,9 @@ usage: expect_app_error.py APP EXIT_CODE FRAGMENT OUT_DIR -- COMMAND [ARGS...]
 import json
 import os
 import shutil
-import subprocess
 import sys
+
+from expect_error import report, run_failing
 
 
 def main():
@@ -17,18 +18,7 @@ def main():
     app, code, fragment, out, cmd = sys.argv[1], int(sys.argv[2]), sys.argv[3], sys.argv[4], sys.argv[sep + 1:]
     if os.path.isdir(out):
         shutil.rmtree(out)
-    r = subprocess.run(cmd, capture_output=True, text=True, timeout=120)
-    # ONE error line; details (lists of valid names) may follow on lines indented by two spaces.
-    lines = [l for l in r.stderr.splitlines() if not l.startswith("  ")]
-    problems = []
-    if r.returncode != code:
-        problems.append(f"exit code {r.returncode}, expected {code}")
-    if len(lines) != 1:
-        problems.append(f"{len(lines)} unindented lines on stderr, expected 1")
-    elif not lines[0].startswith(app + ": error: "):
-        problems.append(f"stderr does not start with '{app}: error: '")
-    if fragment not in r.stderr:
-        problems.append(f"stderr lacks {fragment!r}")
+    r, problems = run_failing(cmd, code, app, fragment, timeout=120)
     run_json = os.path.join(out, "run.json")
     if os.path.isfile(run_json):
         with open(run_json, encoding="utf-8") as f:
@@ -37,10 +27,7 @@ def main():
             problems.append(f"{run_json} says complete")
     elif os.path.isdir(out) and os.listdir(out):
         problems.append(f"{out} was created and is not empty: {os.listdir(out)}")
-    if problems:
-        print("FAIL: " + "; ".join(problems) + "\nstderr was:\n" + r.stderr)
-        sys.exit(1)
-    print("OK: " + lines[0])
+    report(r, problems)
 
 
 if __name__ == "__main__":

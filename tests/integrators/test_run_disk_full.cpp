@@ -6,6 +6,7 @@
 #include "integrators/runs/run_driver.hpp"
 #include "integrators/runs/static_run.hpp"
 #include "lib/problem.hpp"
+#include "tests/support/test_files.hpp"
 
 #include <gtest/gtest.h>
 
@@ -20,28 +21,10 @@ namespace {
 
 namespace fs = std::filesystem;
 
-fs::path scratch_dir(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("shelldyn_test_disk_full_" + name);
-  fs::remove_all(dir);
-  fs::create_directories(dir / "fields");
-  return dir;
-}
+using testing::error_of;
+using testing::read_text;
 
-std::string read_text(const fs::path& p) {
-  std::ifstream in(p);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
-std::string error_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const std::exception& e) {
-    return e.what();
-  }
-  return "(no error)";
-}
+fs::path scratch_dir(const std::string& name) { return testing::scratch_dir("disk_full_" + name, {"fields"}); }
 
 std::vector<std::string> leftovers(const fs::path& dir) {
   std::vector<std::string> out;

@@ -2,6 +2,7 @@
 #include "lib/history_writer.hpp"
 #include "lib/run_info.hpp"
 #include "lib/vtu_writer.hpp"
+#include "tests/support/test_files.hpp"
 
 #include <gtest/gtest.h>
 
@@ -17,12 +18,10 @@ namespace fs = std::filesystem;
 
 namespace {
 
-fs::path scratch_dir(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("shelldyn_test_outputs_" + name);
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir;
-}
+using shelldyn::testing::error_of;
+using shelldyn::testing::read_text;
+
+fs::path scratch_dir(const std::string& name) { return shelldyn::testing::scratch_dir("outputs_" + name); }
 
 std::vector<std::string> read_lines(const fs::path& p) {
   std::ifstream in(p);
@@ -36,13 +35,6 @@ std::vector<std::string> split(const std::string& s, char sep) {
   std::stringstream ss(s);
   for (std::string item; std::getline(ss, item, sep);) out.push_back(item);
   return out;
-}
-
-std::string read_all(const fs::path& p) {
-  std::ifstream in(p);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
 }
 
 size_t count(const std::string& s, const std::string& what) {
@@ -132,7 +124,7 @@ TEST(VtuWriter, WritesBiquadraticQuadsWithFields) {
   const fs::path file = dir / vtu_step_file_name(7);
   EXPECT_EQ(file.filename().string(), "step_000007.vtu");
   write_vtu(file.string(), m, f);
-  const std::string xml = read_all(file);
+  const std::string xml = read_text(file);
   EXPECT_NE(xml.find("NumberOfPoints=\"15\" NumberOfCells=\"2\""), std::string::npos);
   EXPECT_NE(xml.find("Name=\"displacement\" NumberOfComponents=\"3\""), std::string::npos);
   EXPECT_NE(xml.find("Name=\"velocity\""), std::string::npos);
@@ -162,11 +154,11 @@ TEST(PvdWriter, RewritesTheCollectionOnEveryAdd) {
   const fs::path dir = scratch_dir("pvd");
   PvdWriter pvd((dir / "fields.pvd").string());
   pvd.add(0.0, "fields/step_000000.vtu");
-  std::string xml = read_all(dir / "fields.pvd");
+  std::string xml = read_text(dir / "fields.pvd");
   EXPECT_EQ(count(xml, "<DataSet "), 1u);
   EXPECT_NE(xml.find("</VTKFile>"), std::string::npos);  // complete after each add
   pvd.add(0.125, "fields/step_000001.vtu");
-  xml = read_all(dir / "fields.pvd");
+  xml = read_text(dir / "fields.pvd");
   EXPECT_EQ(count(xml, "<DataSet "), 2u);
   EXPECT_NE(xml.find("timestep=\"0.125\" group=\"\" part=\"0\" file=\"fields/step_000001.vtu\""), std::string::npos);
   EXPECT_FALSE(fs::exists(dir / "fields.pvd.tmp"));
@@ -208,7 +200,7 @@ TEST(RunInfo, DocumentHasStatusVersionsCaseAndSummary) {
   info.summary.set("energy", std::numeric_limits<double>::quiet_NaN());
   const fs::path dir = scratch_dir("runjson");
   write_run_json((dir / "run.json").string(), c, info);
-  const std::string json = read_all(dir / "run.json");
+  const std::string json = read_text(dir / "run.json");
   EXPECT_NE(json.find("\"status\": \"incomplete: Newton failed at t = 0.5\""), std::string::npos);
   EXPECT_NE(json.find("\"shelldyn\": \"" + shelldyn_version() + "\""), std::string::npos);
   EXPECT_NE(json.find("\"sundials\": \"6.4.1\""), std::string::npos);
@@ -234,14 +226,6 @@ TEST(RunInfo, DocumentHasStatusVersionsCaseAndSummary) {
 namespace {
 bool have_dev_full() { return fs::exists("/dev/full"); }
 
-std::string error_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const std::exception& e) {
-    return e.what();
-  }
-  return "(no error)";
-}
 }  // namespace
 
 TEST(DiskFull, RunJsonSaysSoAndLeavesNoTemporary) {

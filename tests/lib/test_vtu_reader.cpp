@@ -5,6 +5,7 @@
 #include "lib/state_output.hpp"
 #include "lib/vtu_reader.hpp"
 #include "lib/vtu_writer.hpp"
+#include "tests/support/test_files.hpp"
 
 #include <gtest/gtest.h>
 
@@ -18,21 +19,11 @@ namespace fs = std::filesystem;
 
 namespace {
 
-fs::path scratch_dir(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("shelldyn_test_vtu_reader_" + name);
-  fs::remove_all(dir);
-  fs::create_directories(dir / "fields");
-  return dir;
-}
+using shelldyn::testing::error_of;
+using shelldyn::testing::read_text;
+using shelldyn::testing::write_text;
 
-std::string read_text(const fs::path& p) {
-  std::ifstream in(p);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
-void write_text(const fs::path& p, const std::string& s) { std::ofstream(p) << s; }
+fs::path scratch_dir(const std::string& name) { return shelldyn::testing::scratch_dir("vtu_reader_" + name, {"fields"}); }
 
 // A curved mesh, so that director rates and charts are not trivial.
 const std::string kPanel = "mesh: {generator: cylindrical_panel, radius: 1.0, angle: 1.2, length: 1.5, n_arc: 2, n_axial: 2}\n"
@@ -41,14 +32,6 @@ const std::string kPanel = "mesh: {generator: cylindrical_panel, radius: 1.0, an
 
 Problem panel(const std::string& extra = "") { return make_problem(load_case_from_string(kPanel + extra, "panel.yaml")); }
 
-std::string error_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const std::exception& e) {
-    return e.what();
-  }
-  return "(no error)";
-}
 
 // A deformed, moving state of the panel: translations, rotated directors (same charts), velocities.
 State moving_state(const Model& model) {
