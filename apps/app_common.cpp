@@ -9,6 +9,8 @@
 #include "lib/openmp_wait_policy.hpp"  // passive OpenMP waiting in every app (linked into each of them)
 #ifdef SHELLDYN_HAVE_MPI
 #include "integrators/runs/mpi_executor.hpp"
+#include "integrators/checkpoint/checkpoint.hpp"
+#include "lib/state_output.hpp"
 #endif
 
 
@@ -17,6 +19,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -73,6 +76,38 @@ std::string num(double x) {
 }
 
 }  // namespace
+
+State load_saved_state(Problem& problem, const std::string& given) {
+  namespace fs = std::filesystem;
+  std::string path = given;
+  if (fs::is_directory(path)) path = (fs::path(path) / checkpoint_file_name()).string();
+  if (!fs::exists(path))
+    throw std::invalid_argument("--state " + path + ": no such file (give a run's checkpoint.cbor, its folder, or a fields/step_N.vtu)");
+  Model& model = *problem.model;
+  State s;
+  std::string ext = fs::path(path).extension().string();
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  if (ext == ".vtu") {
+    bool has_time = false;
+    try {
+      s = state_from_vtu(model, path, &has_time);
+    } catch (const std::runtime_error& e) {
+      throw std::invalid_argument("--state " + std::string(e.what()));
+    }
+    if (!has_time)
+      throw std::invalid_argument("--state " + path + ": no fields.pvd of its run folder lists it, so its time (load factor) is "
+                                  "unknown (keep the VTU in DIR/fields/ beside DIR/fields.pvd)");
+  } else {
+    Checkpoint c = read_checkpoint(path);
+    if (c.state.u.size() != model.num_dofs() || static_cast<int>(c.state.charts.size()) != model.mesh().num_nodes())
+      throw std::invalid_argument("--state " + path + ": the checkpoint holds " + std::to_string(c.state.u.size()) +
+                                  " DOFs, this case's model " + std::to_string(model.num_dofs()) +
+                                  " (a checkpoint of another case or mesh?)");
+    s = c.state;
+  }
+  model.adopt_charts(s.charts);
+  return s;
+}
 
 std::string find_case_file(const std::string& file_name) {
   std::string tried;

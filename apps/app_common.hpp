@@ -27,6 +27,12 @@ struct RunSummary;
 
 namespace app {
 
+// `--state FILE` of `static` and `modes` (docs/manual.md §1): a checkpoint.cbor, the folder of a run that
+// wrote one, or a VTU of a run (DIR/fields/step_N.vtu; its time taken from DIR/fields.pvd). Checks that the
+// state belongs to the case's mesh and adopts its director charts in problem.model. Throws
+// std::invalid_argument "--state FILE: reason (how to fix)".
+State load_saved_state(Problem& problem, const std::string& path);
+
 // A case file of apps/cases/ by file name: first <source>/apps/cases (compile definition
 // SHELLDYN_SOURCE_DIR), then <prefix>/share/shelldyn/cases next to the installed executable. Throws
 // naming every place searched and suggesting --case.

@@ -31,11 +31,12 @@ struct ModesOptions {
 };
 
 // "initial" -> the reference state; "static" / "static:LAMBDA" -> the case solved statically (its
-// integrator block must be `name: static`) to t_end or LAMBDA.
+// integrator block must be `name: static`) to t_end or LAMBDA; anything else -> a saved state FILE
+// (app::load_saved_state: checkpoint.cbor, run folder or run VTU), linearised at its time.
 State modes_state(Problem& problem, const std::string& which, bool* loaded) {
   *loaded = false;
   if (which == "initial") return problem.initial_state();
-  if (which.rfind("static", 0) == 0) {
+  if (which == "static" || which.rfind("static:", 0) == 0) {  // not a file such as static/fields/step_000004.vtu
     double lambda = problem.spec.time.t_end;
     if (which.size() > 6) {
       if (which[6] != ':') throw std::invalid_argument("--state '" + which + "': expected initial, static or static:LAMBDA");
@@ -54,7 +55,11 @@ State modes_state(Problem& problem, const std::string& which, bool* loaded) {
     *loaded = true;
     return s;
   }
-  throw std::invalid_argument("--state '" + which + "': expected initial, static or static:LAMBDA");
+  // A saved state (docs/manual.md §1): a checkpoint, a run folder holding one, or a run's VTU.
+  State s = load_saved_state(problem, which);
+  std::cout << "saved state " << which << " at load factor (time) " << s.t << "\n";
+  *loaded = true;
+  return s;
 }
 
 int run_modes(const ModesOptions& o) {
@@ -194,7 +199,8 @@ void add_modes_command(CLI::App& app, std::function<int()>& action, const std::s
       ->check(CLI::NonNegativeNumber);
   sub->add_option("--state", o->state,
                   "Linearise about: initial (default) | static (the case solved statically to t_end; K includes the "
-                  "geometric and load stiffness) | static:LAMBDA (to load factor LAMBDA)");
+                  "geometric and load stiffness) | static:LAMBDA (to load factor LAMBDA) | FILE (a saved state: a "
+                  "checkpoint.cbor or run folder, or a run's DIR/fields/step_N.vtu at the time DIR/fields.pvd gives it)");
   sub->add_option("--dt", o->dt, "Time step to judge: adds steps per period for every mode and counts modes with < 20");
   sub->add_option("--linear-solver", o->linear_solver, "Sparse factorization for (K - sigma M): eigen-ldlt (default), cholmod, klu");
   sub->add_option("-o,--output", o->out_dir, "Result folder (default: results/<case>/modes)");

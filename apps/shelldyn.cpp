@@ -75,7 +75,7 @@ struct CheckOptions {
   std::string out_dir;  // empty: results/<case name>
   std::string command;  // the full command line, recorded in run.json
   bool overwrite = false;
-  std::string state_file;  // static: start from this checkpoint (or run folder holding one)
+  std::string state_file;  // static: start from this checkpoint (or run folder holding one) or run VTU
 };
 
 void print_summary(std::ostream& out, const CaseSpec& c, const Discretization& d) {
@@ -154,7 +154,14 @@ VtuFields initial_fields(const Discretization& d) {
   for (Index dof : d.dofs.constrained_dofs()) fixed.values[static_cast<size_t>(dof / kDofsPerNode)] += 1.0;
   ScalarField load{"load_magnitude", std::vector<double>(n, 0.0)};
   for (const auto& l : d.loads) load.values[static_cast<size_t>(l.node)] += l.vector.norm();
-  f.point_scalars = {std::move(fixed), std::move(load)};
+  // Director rate ṗ = A1(q0) q̇ (as state_fields writes it), so this VTU can serve as a velocity field.
+  ScalarField pdot{"director_rate", std::vector<double>(3 * n, 0.0), 3};
+  for (size_t i = 0; i < n; ++i) {
+    const Eigen::Index k = static_cast<Eigen::Index>(DofMap::dof(static_cast<int>(i), 3));
+    const Vec3 w = director_A1(chart_coordinates(d.normals[i], d.charts[i]), d.charts[i]) * d.initial_velocity.segment<2>(k);
+    for (size_t c = 0; c < 3; ++c) pdot.values[3 * i + c] = w[static_cast<Eigen::Index>(c)];
+  }
+  f.point_scalars = {std::move(pdot), std::move(fixed), std::move(load)};
   return f;
 }
 
@@ -322,6 +329,10 @@ int run_resume(const RunCommandOptions& o) {
   check_run_flags(o);
   const std::string dir = o.case_path;
   const Checkpoint c = read_checkpoint((fs::path(dir) / checkpoint_file_name()).string());
+  // A run killed with SIGKILL leaves its disk reserve (lib/run_info.hpp DiskReserve) behind: stale, remove it
+  // (the resumed run allocates its own and deletes it at the end, whatever the outcome).
+  std::error_code ec;
+  fs::remove(fs::path(dir) / "run.json.reserve", ec);
   Problem problem = problem_from_checkpoint(c);
   RunOptions ro = run_options_from_checkpoint(c);
   ro.out_dir = dir;
@@ -362,19 +373,8 @@ int run_static_command(const CheckOptions& o) {
   // --state: the configuration of a saved run (its checkpoint) as the starting point, its time as λ₀.
   std::unique_ptr<State> start;
   if (!o.state_file.empty()) {
-    std::string path = o.state_file;
-    if (fs::is_directory(path)) path = (fs::path(path) / checkpoint_file_name()).string();
-    if (!fs::exists(path))
-      throw std::invalid_argument("--state " + path + ": no such file (give a checkpoint.cbor, or the folder of a run "
-                                  "that wrote one: shelldyn run --checkpoint-every ...)");
-    Checkpoint c = read_checkpoint(path);
-    if (c.state.u.size() != problem.model->num_dofs() ||
-        static_cast<int>(c.state.charts.size()) != problem.model->mesh().num_nodes())
-      throw std::invalid_argument("--state " + path + ": the checkpoint holds " + std::to_string(c.state.u.size()) +
-                                  " DOFs, this case's model " + std::to_string(problem.model->num_dofs()) +
-                                  " (a checkpoint of another case or mesh?)");
-    start = std::make_unique<State>(c.state);
-    std::cout << "starting from " << path << " (t = " << c.state.t << ") at load factor " << c.state.t << std::endl;
+    start = std::make_unique<State>(app::load_saved_state(problem, o.state_file));
+    std::cout << "starting from " << o.state_file << " at load factor " << start->t << std::endl;
   }
   StaticReport report;
   const auto rows = run_static(problem, dir, &std::cout, &report, start.get());
@@ -400,8 +400,8 @@ void add_static_command(CLI::App& app, Action& action, const std::string& comman
   sub->add_option("-o,--output", opts->out_dir, "Result folder (default: results/<case>/static)");
   sub->add_flag("--overwrite", opts->overwrite, "Replace the results of an earlier command in the result folder");
   sub->add_option("--state", opts->state_file,
-                  "Start from a saved state: a checkpoint.cbor of `shelldyn run` (or its run folder); its time is the "
-                  "starting load factor, velocities are ignored (default: the reference state at load factor 0)");
+                  "Start from a saved state: a checkpoint.cbor of `shelldyn run` (or its run folder), or a VTU of a run "
+                  "(DIR/fields/step_N.vtu, its time from DIR/fields.pvd); its time is the starting load factor, velocities are ignored (default: the reference state at load factor 0)");
   sub->callback([opts, &action] { action = [opts] { return run_static_command(*opts); }; });
 }
 
@@ -505,10 +505,12 @@ void add_compare_command(CLI::App& app, Action& action, const std::string& comma
 // --- study -------------------------------------------------------------------------------------------
 // `shelldyn study BENCHMARK`: the integrator study of integrators/runs/study.hpp (work–precision sweep on a
 // window + full-duration conservation runs, resumable), then scripts/plot_study.py. Exit 0 when every run
-// completed, 3 when some failed, 1 for bad input.
+// completed or stopped at the per-run budget, 3 when some failed, 1 for bad input.
 struct StudyCommandOptions {
   std::string benchmark, case_path, out_dir, command, only = "all";
   int jobs = 2;
+  double max_wall_per_run = 0.0;
+  long long max_steps_per_run = 0;
   bool rerun = false, dry_run = false, no_plots = false;
 };
 
@@ -522,6 +524,10 @@ int run_study_command(const StudyCommandOptions& o) {
   else if (o.only != "all")
     throw std::invalid_argument("--only must be window, full or all (got '" + o.only + "')");
   so.out_dir = o.out_dir.empty() ? (fs::path("results") / o.benchmark / "study").string() : o.out_dir;
+  if (!(o.max_wall_per_run >= 0.0) || !std::isfinite(o.max_wall_per_run) || o.max_steps_per_run < 0)
+    throw std::invalid_argument("--max-wall-per-run and --max-steps-per-run must be >= 0 (0: no budget)");
+  so.max_wall_per_run = o.max_wall_per_run;
+  so.max_steps_per_run = o.max_steps_per_run;
   so.rerun = o.rerun;
   so.dry_run = o.dry_run;
   so.execution.jobs = o.jobs;
@@ -535,8 +541,8 @@ int run_study_command(const StudyCommandOptions& o) {
   if (!so.report) so.log = nullptr;
   const StudyResult r = run_study(so);
   if (o.dry_run || !so.report) return 0;
-  std::cout << "study " << o.benchmark << ": " << r.ran << " runs made, " << r.skipped << " already complete, " << r.failed
-            << " failed; wrote " << r.study_csv << ", " << r.study_md << std::endl;
+  std::cout << "study " << o.benchmark << ": " << r.ran << " runs made, " << r.skipped << " kept from earlier, " << r.stopped
+            << " stopped at the per-run budget, " << r.failed << " failed; wrote " << r.study_csv << ", " << r.study_md << std::endl;
   if (!o.no_plots && app::run_python_script(app::find_script("plot_study.py"), {so.out_dir}, std::cout))
     std::cout << "wrote " << so.out_dir << "/work_precision.png, full_energy.png, full_momentum.png" << std::endl;
   return r.failed ? 3 : 0;
@@ -555,6 +561,11 @@ void add_study_command(CLI::App& app, Action& action, const std::string& command
   sub->add_option("-o,--output", o->out_dir, "Result folder (default: results/<benchmark>/study)");
   sub->add_option("--jobs", o->jobs, "Runs at a time, each single-threaded (default 2)");
   sub->add_option("--only", o->only, "Run only the group window (work-precision sweep) or full (full duration); default all");
+  sub->add_option("--max-wall-per-run", o->max_wall_per_run,
+                  "Budget per run in wall seconds (default 0: none); a run that hits it is reported as stopped at budget "
+                  "with the time reached, never as complete");
+  sub->add_option("--max-steps-per-run", o->max_steps_per_run,
+                  "Budget per run in steps, checked at output times (default 0: none); reported as --max-wall-per-run");
   sub->add_flag("--rerun", o->rerun, "Run completed runs again (default: keep them; the study resumes)");
   sub->add_flag("--dry-run", o->dry_run, "List the runs and which are complete; run nothing");
   sub->add_flag("--no-plots", o->no_plots, "Do not call scripts/plot_study.py");

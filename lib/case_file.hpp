@@ -25,7 +25,7 @@
 //     NAME: {point: [x,y,z], [tol]} | {box: [[xmin,ymin,zmin],[xmax,ymax,zmax]]}
 //         | {nodes: [i, ...]}  (0-based) | {union: [NAME, ...]}
 //   boundary_conditions: [{set, fix: [ux|uy|uz|px|py|pz|director, ...]}, ...]          optional
-//   initial_velocity: {[set = all], [translation], [angular], [about: centroid | [x,y,z]] | [field: v.csv]
+//   initial_velocity: {[set = all], [translation], [angular], [about: centroid | [x,y,z]] | [field: v.csv | fields/step_N.vtu]
 //                      | [mode: mode_shapes.csv, index: k, amplitude: A]}
 //                     or a list of such entries (later ones override earlier ones)         optional
 //   loads: [{set, type: force|moment, direction, amplitude, [distribution: per_node|edge_total|per_length],

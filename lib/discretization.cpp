@@ -5,8 +5,10 @@
 #include "lib/gmsh_reader.hpp"
 #include "lib/mesh_generators.hpp"
 #include "lib/nodal_normals.hpp"
+#include "lib/vtu_reader.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <fstream>
 #include <array>
 #include <functional>
@@ -34,6 +36,15 @@ std::string fmt(const Vec3& x) {
   return os.str();
 }
 
+// The lower-case extension of a path (".vtu", ".csv", or "").
+std::string fs_extension(const std::string& path) {
+  const size_t slash = path.find_last_of('/'), dot = path.find_last_of('.');
+  if (dot == std::string::npos || (slash != std::string::npos && dot < slash)) return "";
+  std::string ext = path.substr(dot);
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return ext;
+}
+
 std::string available_sets(const Mesh& mesh) {
   std::string out;
   for (const auto& [name, nodes] : mesh.node_sets) out += (out.empty() ? "" : ", ") + name;
@@ -48,9 +59,33 @@ const std::vector<int>& find_set(const Mesh& mesh, const std::string& name, cons
   return it->second;
 }
 
-// A CSV velocity field "node,vx,vy,vz[,pdx,pdy,pdz]" (header line, 0-based node indices): node -> (v, ṗ).
-std::map<int, Eigen::Matrix<double, 6, 1>> read_velocity_field(const std::string& path, int num_nodes,
+// A velocity field (docs/manual.md §2.6): node -> (v, ṗ). Either a VTU written by shelldyn (point data
+// `velocity` and, if present, `director_rate`; every node; its reference positions must be the mesh's) or a CSV
+// "node,vx,vy,vz[,pdx,pdy,pdz]" (header line, 0-based node indices, any subset of the nodes).
+std::map<int, Eigen::Matrix<double, 6, 1>> read_velocity_field(const std::string& path, const Mesh& mesh,
                                                                const std::string& where) {
+  const int num_nodes = mesh.num_nodes();
+  std::string ext = fs_extension(path);
+  if (ext == ".vtu") {
+    std::map<int, Eigen::Matrix<double, 6, 1>> out;
+    try {
+      const VtuPointData vtu = read_vtu(path);
+      check_vtu_matches_mesh(vtu, mesh.X);
+      const std::vector<Vec3> v = vtu.vectors("velocity");
+      const std::vector<Vec3> pdot =
+          vtu.has("director_rate") ? vtu.vectors("director_rate") : std::vector<Vec3>(v.size(), Vec3::Zero());
+      for (int i = 0; i < num_nodes; ++i) {
+        Eigen::Matrix<double, 6, 1> x;
+        x << v[static_cast<size_t>(i)], pdot[static_cast<size_t>(i)];
+        out[i] = x;
+      }
+    } catch (const std::runtime_error& e) {
+      fail(where, e.what());
+    }
+    return out;
+  }
+  if (ext != ".csv")
+    fail(where, "the velocity field '" + path + "' must be a .vtu or a .csv file (docs/manual.md §2.6)");
   std::ifstream in(path);
   if (!in) fail(where, "cannot open the velocity field '" + path + "' (check the path; relative to the case file)");
   std::string line;
@@ -340,7 +375,7 @@ Discretization build_discretization(const CaseSpec& spec) {
     if (!iv.field.empty() || !iv.mode_file.empty()) {
       // A CSV field, or a mode shape of `shelldyn modes` scaled by the amplitude (same format once read).
       const auto field = iv.mode_file.empty()
-                             ? read_velocity_field(iv.field, n, iv.where + ".field")
+                             ? read_velocity_field(iv.field, mesh, iv.where + ".field")
                              : read_mode_field(iv.mode_file, iv.mode_index, iv.mode_amplitude, n, iv.where);
       for (const auto& [node, vel] : field) {
         if (!std::binary_search(nodes.begin(), nodes.end(), node)) continue;

@@ -1,7 +1,10 @@
 #include "lib/state_output.hpp"
 
+#include "lib/vtu_reader.hpp"
+
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 #include <stdexcept>
 
 namespace shelldyn {
@@ -17,6 +20,18 @@ VtuFields state_fields(const Model& model, const State& state, const Eigen::Vect
     f.velocity[static_cast<size_t>(i)] = state.v.segment<3>(DofMap::dof(i, 0));
     f.director[static_cast<size_t>(i)] = model.director(state, i);
   }
+  // Director rate ṗ (3 components): with it a VTU holds the whole velocity state, so a run can start from it
+  // (initial_velocity: {field: FILE.vtu}, docs/manual.md §2.6).
+  ScalarField pdot{"director_rate", std::vector<double>(static_cast<size_t>(3 * n)), 3};
+  for (int i = 0; i < n; ++i) {
+    const size_t si = static_cast<size_t>(i);
+    const Vec3 w = state.pdot.size() == 3 * static_cast<Eigen::Index>(n)
+                       ? Vec3(state.pdot.segment<3>(3 * static_cast<Eigen::Index>(i)))
+                       : Vec3(director_A1(state.u.segment<2>(DofMap::dof(i, 3)), state.charts[si]) *
+                              state.v.segment<2>(DofMap::dof(i, 3)));
+    for (int c = 0; c < 3; ++c) pdot.values[3 * si + static_cast<size_t>(c)] = w[c];
+  }
+  f.point_scalars.push_back(std::move(pdot));
   if (reactions) {
     ScalarField r{"reaction", std::vector<double>(static_cast<size_t>(3 * n)), 3};
     for (int i = 0; i < n; ++i)
@@ -46,6 +61,53 @@ VtuFields state_fields(const Model& model, const State& state, const Eigen::Vect
   }
   for (ScalarField* s : {&Nf, &Mf, &Qf, &ef, &kf, &gf, &uf}) f.cell_scalars.push_back(std::move(*s));
   return f;
+}
+
+State state_from_vtu(const Model& model, const std::string& path, bool* has_time) {
+  const VtuPointData vtu = read_vtu(path);
+  const Mesh& mesh = model.mesh();
+  check_vtu_matches_mesh(vtu, mesh.X);
+  const std::vector<Vec3> d = vtu.vectors("displacement"), p = vtu.vectors("director"), v = vtu.vectors("velocity");
+  const std::vector<Vec3> pdot = vtu.has("director_rate") ? vtu.vectors("director_rate") : std::vector<Vec3>(v.size(), Vec3::Zero());
+  State s = model.initial_state();
+  *has_time = vtu_time_from_pvd(path, &s.t);
+  if (!*has_time) s.t = 0.0;
+  const int n = mesh.num_nodes();
+  for (int i = 0; i < n; ++i) {
+    const size_t si = static_cast<size_t>(i);
+    if (std::abs(p[si].norm() - 1.0) > 1e-8)
+      throw std::runtime_error(path + ": the director at point " + std::to_string(i) + " has length " +
+                               std::to_string(p[si].norm()) + ", not 1 (not a shelldyn state?)");
+    const Vec3 pi = p[si].normalized();
+    s.charts[si] = select_chart(pi);
+    s.u.segment<3>(DofMap::dof(i, 0)) = d[si];
+    s.u.segment<2>(DofMap::dof(i, 3)) = chart_coordinates(pi, s.charts[si]);
+    s.v.segment<3>(DofMap::dof(i, 0)) = v[si];
+    s.v.segment<2>(DofMap::dof(i, 3)) = chart_coordinates(pdot[si] - pdot[si].dot(pi) * pi, s.charts[si]);
+  }
+  // Fixed DOFs must hold their prescribed values: zero displacement, the reference director's fixed parts.
+  double size = 0.0;
+  for (const Vec3& x : mesh.X) size = std::max(size, (x - mesh.X.front()).norm());
+  const std::vector<Vec3>& p0 = model.normals();
+  DofMap dofs = model.dofs();  // the constraints resolved for the state's charts
+  try {
+    dofs.resolve(s.charts);
+  } catch (const std::exception& e) {
+    throw std::runtime_error(path + ": " + e.what() + " (a state of other boundary conditions?)");
+  }
+  for (Index dof : dofs.constrained_dofs()) {
+    const int node = static_cast<int>(dof / kDofsPerNode), c = static_cast<int>(dof % kDofsPerNode);
+    const size_t sn = static_cast<size_t>(node);
+    const double bad = c < 3 ? std::abs(d[sn][c]) / std::max(size, 1e-300)
+                             : std::abs(s.u[dof] - chart_coordinates(p0[sn], s.charts[sn])[c - 3]);
+    if (bad > 1e-9) {
+      std::ostringstream os;
+      os << path << ": node " << node << " has " << (c < 3 ? "displacement " : "director ") << "component " << c
+         << " away from the value its boundary condition fixes (a state of other boundary conditions?)";
+      throw std::runtime_error(os.str());
+    }
+  }
+  return s;
 }
 
 void prepare_output_folder(const std::string& dir) {

@@ -166,7 +166,7 @@ void PvdWriter::add(double time, const std::string& file) {
   // Write a complete new file and rename it over the old one: a reader never sees a half-written
   // collection, and a killed run leaves the last complete list.
   const std::string tmp = path_ + ".tmp";
-  {
+  try {
     File out(tmp);
     std::FILE* f = out.get();
     std::fprintf(f, "<?xml version=\"1.0\"?>\n");
@@ -177,6 +177,11 @@ void PvdWriter::add(double time, const std::string& file) {
                    xml_escape(name).c_str());
     std::fprintf(f, "  </Collection>\n</VTKFile>\n");
     out.close();
+  } catch (const std::runtime_error& e) {  // name the collection, not its temporary (File removed that)
+    entries_.pop_back();                    // the file on disk (if any) still lists the earlier entries
+    std::string what = e.what();
+    if (what.rfind(tmp, 0) == 0) what = path_ + what.substr(tmp.size());
+    throw std::runtime_error(what);
   }
   std::error_code ec;
   std::filesystem::rename(tmp, path_, ec);

@@ -552,6 +552,8 @@ CompareResult run_comparison(const CompareOptions& o) {
     ro.t_end = o.t_end;
     ro.output_interval = o.output_interval;
     ro.vtu_every = o.vtu_every;
+    ro.max_wall = o.max_wall;
+    ro.max_steps = o.max_steps;
     ro.threads = threads;
     ro.log = &runlog;
     ro.command = o.command + "  [run " + run.label + "]";

@@ -66,6 +66,8 @@ struct CompareOptions {
   int threads = 0;                  // OpenMP threads per run when jobs == 1 (0: default)
   RunExecutor* executor = nullptr;  // where runs execute (null: a local pool of `jobs` threads)
   bool resume = false;              // reuse finished runs of an earlier sweep (see above)
+  double max_wall = 0.0;            // per-run budget: RunOptions::max_wall / max_steps of every run (0: none); a
+  long long max_steps = 0;          // run that hits it is a row "failed: stopped: --max-wall ..." (run.json says so)
   std::string out_dir;              // required
   std::string reference;            // label of the reference run (empty: automatic, see above)
   std::ostream* log = nullptr;      // one line per run start/finish

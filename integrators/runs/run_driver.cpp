@@ -491,7 +491,12 @@ RunSummary run_dynamic(Problem& problem, const RunOptions& o) {
     if (vtu_now) {
       const std::string file = "fields/" + vtu_step_file_name(out_index);
       write_vtu(o.out_dir + "/" + file, model.mesh(), state_fields(model, state, &R));
-      pvd->add(state.t, file);
+      try {
+        pvd->add(state.t, file);
+      } catch (const std::exception&) {  // (full disk) a VTU that fields.pvd cannot list is not kept
+        std::remove((o.out_dir + "/" + file).c_str());
+        throw;
+      }
     }
     const bool due = tty ? (last || wall - last_print >= 0.2) : (last || out_index == 0 || state.t >= next_plain_t);
     if (o.log && due) {
@@ -592,7 +597,10 @@ RunSummary run_dynamic(Problem& problem, const RunOptions& o) {
                        (policy.wall > 0.0 && elapsed() >= next_ckpt_wall);
       if (due && can_checkpoint) {
         write_ckpt(next_k);
-        write_status(info.status, false);  // run.json names the checkpoint
+        // run.json names the checkpoint; if it cannot be written (the disk filled up), stop: the catch below
+        // releases the disk reserve and records the cause, instead of run.json silently lagging behind.
+        const std::string json_error = write_status(info.status, false);
+        if (!json_error.empty()) throw std::runtime_error(json_error);
         if (policy.steps > 0) next_ckpt_step = (sum.totals.steps / policy.steps + 1) * policy.steps;
         if (policy.sim_time > 0.0) next_ckpt_time = (std::floor(state.t / policy.sim_time + 1e-9) + 1.0) * policy.sim_time;
         if (policy.wall > 0.0) next_ckpt_wall = elapsed() + policy.wall;

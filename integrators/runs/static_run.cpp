@@ -6,13 +6,44 @@
 #include "lib/run_info.hpp"
 #include "lib/state_output.hpp"
 
+#include <cerrno>
 #include <cstdio>
+#include <cstring>
 #include <limits>
-#include <fstream>
 #include <memory>
 #include <stdexcept>
 
 namespace shelldyn {
+
+namespace {
+
+// static.csv through a checked writer: every row is flushed, and a failed write (a full disk) is an error
+// naming the file, as for history.csv (lib/history_writer.hpp), instead of a silently truncated table.
+class CsvFile {
+ public:
+  explicit CsvFile(std::string path) : path_(std::move(path)), f_(std::fopen(path_.c_str(), "w")) {
+    if (!f_) throw std::runtime_error(path_ + ": cannot create static.csv: " + std::strerror(errno));
+  }
+  ~CsvFile() {
+    if (f_) std::fclose(f_);
+  }
+  CsvFile(const CsvFile&) = delete;
+  CsvFile& operator=(const CsvFile&) = delete;
+  void write(const std::string& text) {
+    errno = 0;
+    if (std::fwrite(text.data(), 1, text.size(), f_) != text.size() || std::fflush(f_) != 0) {
+      const int err = errno ? errno : EIO;
+      throw std::runtime_error(path_ + ": cannot write static.csv: " +
+                               (err == ENOSPC ? std::string("the disk is full (free space and rerun)") : std::strerror(err)));
+    }
+  }
+
+ private:
+  std::string path_;
+  std::FILE* f_;
+};
+
+}  // namespace
 
 StaticOptions static_options(const CaseSpec& spec, const Discretization* disc) {
   IntegratorSettings s(spec.integrator);
@@ -67,8 +98,9 @@ std::vector<StaticRow> run_static(Problem& problem, const std::string& out_dir, 
   model.set_unsymmetric_load_stiffness(options.linear_solver == "klu");
   const auto& monitors = problem.disc.monitors;
 
-  std::unique_ptr<std::ofstream> csv;
+  std::unique_ptr<CsvFile> csv;
   std::unique_ptr<PvdWriter> pvd;
+  std::unique_ptr<DiskReserve> reserve;  // room for the final run.json on a disk the outputs fill (lib/run_info.hpp)
   RunInfo info;
   info.sundials_version = sundials_version();
   info.status = "incomplete: running";
@@ -79,10 +111,8 @@ std::vector<StaticRow> run_static(Problem& problem, const std::string& out_dir, 
   if (!out_dir.empty()) {
     prepare_output_folder(out_dir);
     write_run_json(out_dir + "/run.json", spec, info);
-    csv = std::make_unique<std::ofstream>(out_dir + "/static.csv");
-    *csv << "step,load_factor";
-    for (const auto& m : monitors) *csv << ',' << m.name;
-    *csv << ",newton_iters,arc_length,negative_pivots,event\n";
+    reserve = std::make_unique<DiskReserve>(out_dir + "/run.json.reserve",
+                                            65536 + 4 * static_cast<long long>(run_json(spec, info).size()));
     pvd = std::make_unique<PvdWriter>(out_dir + "/fields.pvd");
   }
 
@@ -99,20 +129,26 @@ std::vector<StaticRow> run_static(Problem& problem, const std::string& out_dir, 
       row.monitors.push_back(monitor_value(m, model.mesh(), s.u, s.v, s.charts, R.size() ? &R : nullptr));
     if (csv) {
       char buf[64];
-      *csv << step;
+      std::string line = std::to_string(step);
       std::snprintf(buf, sizeof buf, ",%.17g", s.t);
-      *csv << buf;
+      line += buf;
       for (double x : row.monitors) {
         std::snprintf(buf, sizeof buf, ",%.17g", x);
-        *csv << buf;
+        line += buf;
       }
       std::snprintf(buf, sizeof buf, ",%d,%.17g,%ld,", iters, arc, pivots);
-      *csv << buf << (event.empty() ? "-" : event) << '\n' << std::flush;
+      line += buf + (event.empty() ? std::string("-") : event) + '\n';
+      csv->write(line);
     }
     if (write_vtu_now) {
       const std::string file = "fields/" + vtu_step_file_name(step);  // like run (docs/manual.md §4)
       write_vtu(out_dir + "/" + file, model.mesh(), state_fields(model, s, &R));
-      pvd->add(s.t, file);
+      try {
+        pvd->add(s.t, file);
+      } catch (const std::exception&) {  // (full disk) a VTU that fields.pvd cannot list is not kept
+        std::remove((out_dir + "/" + file).c_str());
+        throw;
+      }
     }
     row.arc_length = arc;
     row.negative_pivots = pivots;
@@ -136,6 +172,12 @@ std::vector<StaticRow> run_static(Problem& problem, const std::string& out_dir, 
   }
   StaticReport report;
   try {  // bad settings and I/O errors too must end in "incomplete: <reason>", not "running"
+    if (!out_dir.empty()) {
+      csv = std::make_unique<CsvFile>(out_dir + "/static.csv");
+      std::string header = "step,load_factor";
+      for (const auto& m : monitors) header += ',' + m.name;
+      csv->write(header + ",newton_iters,arc_length,negative_pivots,event\n");
+    }
     record(state, 0, 0, 0.0, 0, "");
     StaticSolver solver(model, options);
     report = solver.solve(state, spec.time.t_end, [&](const State& s, const StaticIncrement& inc) {
@@ -154,6 +196,7 @@ std::vector<StaticRow> run_static(Problem& problem, const std::string& out_dir, 
   } catch (const std::exception& e) {
     if (!out_dir.empty()) {
       info.status = std::string("incomplete: ") + e.what();
+      if (reserve) reserve->release();  // the room kept for this last word
       try {
         write_run_json(out_dir + "/run.json", spec, info);
       } catch (const std::exception& j) {  // e.g. the disk is full: report the cause, then this
@@ -184,6 +227,7 @@ std::vector<StaticRow> run_static(Problem& problem, const std::string& out_dir, 
   }
   if (log)
     for (const auto& cp : report.critical_points) *log << "critical point at step " << cp.step << ": " << cp.note << std::endl;
+  if (reserve) reserve->release();
   if (!out_dir.empty()) write_run_json(out_dir + "/run.json", spec, info);
   if (report_out) *report_out = report;
   return rows;

@@ -153,6 +153,18 @@ StudyPreset study_preset(const std::string& name) {
   throw std::invalid_argument("study: unknown benchmark '" + name + "' (available: " + list + ")");
 }
 
+std::pair<std::string, double> stopped_budget(const std::string& status) {
+  for (const std::string kind : {"max-wall", "max-steps"}) {
+    const std::string key = "stopped: --" + kind + " ";
+    if (status.rfind(key, 0) != 0) continue;
+    const char* begin = status.c_str() + key.size();
+    char* end = nullptr;
+    const double x = std::strtod(begin, &end);
+    if (end != begin && x > 0.0) return {kind, x};
+  }
+  return {"", 0.0};
+}
+
 std::string run_json_status(const std::string& text) {
   const std::string key = "\"status\": \"";
   const auto p = text.find(key);
@@ -197,6 +209,8 @@ StudyResult run_study(const StudyOptions& o) {
     co.t_end = group == "window" ? p.window_t_end : -1.0;
     co.output_interval = group == "window" ? p.window_output : p.full_output;
     co.out_dir = (fs::path(o.out_dir) / group).string();
+    co.max_wall = o.max_wall_per_run;
+    co.max_steps = o.max_steps_per_run;
     co.log = o.report ? o.log : nullptr;
     co.command = o.command;
     for (const auto& r : runs) co.specs.push_back(r.spec);
@@ -205,9 +219,16 @@ StudyResult run_study(const StudyOptions& o) {
     for (size_t k = 0; k < runs.size(); ++k) {
       labelled[group].emplace_back(runs[k], expanded[k].label);
       const std::string status = run_json_status(read_text((fs::path(co.out_dir) / expanded[k].label / "run.json").string()));
-      if (status == "complete" && !o.rerun) {
+      // Stopped at a budget at least as large as today's: it would stop again, keep it.
+      const auto [kind, budget] = stopped_budget(status);
+      const bool budget_kept = (kind == "max-wall" && o.max_wall_per_run > 0.0 && o.max_wall_per_run <= budget) ||
+                               (kind == "max-steps" && o.max_steps_per_run > 0 && o.max_steps_per_run <= budget);
+      if ((status == "complete" || budget_kept) && !o.rerun) {
         ++result.skipped;
-        if (o.dry_run) say("  " + group + "/" + expanded[k].label + ": complete (kept)");
+        if (o.dry_run)
+          say("  " + group + "/" + expanded[k].label +
+              (budget_kept ? ": stopped at budget --" + kind + " " + num(budget) + " (kept; a larger budget reruns it)"
+                           : ": complete (kept)"));
       } else {
         pending.push_back(runs[k].spec);
         if (o.dry_run) say("  " + group + "/" + expanded[k].label + ": to run");
@@ -231,6 +252,8 @@ StudyResult run_study(const StudyOptions& o) {
     for (const auto& [run, label] : runs)
       if (run.kind == "reference") {
         ref_label = label;
+        // Only a complete reference measures errors (one stopped at the budget covers part of the window).
+        if (run_json_status(read_text((fs::path(o.out_dir) / group / label / "run.json").string())) != "complete") continue;
         try {
           ref_table[group] = read_csv_table((fs::path(o.out_dir) / group / label / "history.csv").string());
         } catch (const std::exception&) {
@@ -250,7 +273,12 @@ StudyResult run_study(const StudyOptions& o) {
       const std::string json = read_text((dir / "run.json").string());
       row.status = json.empty() ? "not run" : run_json_status(json);
       if (row.status.rfind("incomplete", 0) == 0) row.status = "failed: " + row.status.substr(std::min<size_t>(12, row.status.size()));
-      if (row.status == "complete") {
+      if (!stopped_budget(row.status).first.empty()) {
+        // Stopped at the per-run budget: what it cost and how far it got; no error measures (they would
+        // cover part of the window only).
+        row.stop_note = row.status.substr(0, row.status.find(" at t = "));
+        row.status = "stopped at budget";
+        ++result.stopped;
         row.steps = static_cast<long>(run_json_number(json, "steps"));
         row.rhs_evaluations = static_cast<long>(run_json_number(json, "rhs_evaluations"));
         row.factorizations = static_cast<long>(run_json_number(json, "factorizations"));
@@ -258,6 +286,22 @@ StudyResult run_study(const StudyOptions& o) {
         row.cpu_s = run_json_number(json, "cpu_s");
         row.wall_s = run_json_number(json, "wall_s");
         row.t_end = run_json_number(json, "t_end");
+        try {
+          const CsvTable h = read_csv_table((dir / "history.csv").string());
+          const auto* t = h.column("t");
+          row.t_reached = t && !t->empty() ? t->back() : 0.0;
+        } catch (const std::exception&) {
+          row.t_reached = NaN;
+        }
+      } else if (row.status == "complete") {
+        row.steps = static_cast<long>(run_json_number(json, "steps"));
+        row.rhs_evaluations = static_cast<long>(run_json_number(json, "rhs_evaluations"));
+        row.factorizations = static_cast<long>(run_json_number(json, "factorizations"));
+        row.nonlinear_iterations = static_cast<long>(run_json_number(json, "nonlinear_iterations"));
+        row.cpu_s = run_json_number(json, "cpu_s");
+        row.wall_s = run_json_number(json, "wall_s");
+        row.t_end = run_json_number(json, "t_end");
+        row.t_reached = row.t_end;
         row.max_dL = run_json_number(json, "max_abs_dL_after_loads");
         row.max_dJ = run_json_number(json, "max_abs_dJ_after_loads");
         row.ref_L = run_json_number(json, "norm_L_ref");
@@ -285,14 +329,14 @@ StudyResult run_study(const StudyOptions& o) {
   {
     std::ofstream csv(result.study_csv);
     if (!csv) throw std::runtime_error(result.study_csv + ": cannot write");
-    csv << "group,label,integrator,kind,dt,rtol,t_end,steps,rhs_evaluations,factorizations,nonlinear_iterations,cpu_s,wall_s,"
+    csv << "group,label,integrator,kind,dt,rtol,t_end,t_reached,steps,rhs_evaluations,factorizations,nonlinear_iterations,cpu_s,wall_s,"
            "energy_error,energy_error_after_loads,displacement_error,max_dL,max_dJ,norm_L_ref,norm_J_ref,status\n";
     for (const auto& r : result.rows) {
-      std::string status = r.status;
+      std::string status = r.stop_note.empty() ? r.status : r.status + " (" + r.stop_note + ")";
       for (char& c : status)
         if (c == ',' || c == '\n' || c == '"') c = ';';
       csv << r.group << "," << r.label << "," << r.integrator << "," << r.kind << "," << full(r.dt) << "," << full(r.rtol) << ","
-          << full(r.t_end) << "," << r.steps << "," << r.rhs_evaluations << "," << r.factorizations << ","
+          << full(r.t_end) << "," << full(r.t_reached) << "," << r.steps << "," << r.rhs_evaluations << "," << r.factorizations << ","
           << r.nonlinear_iterations << "," << full(r.cpu_s) << "," << full(r.wall_s) << "," << full(r.energy_error) << ","
           << full(r.energy_error_after_loads) << "," << full(r.displacement_error) << "," << full(r.max_dL) << "," << full(r.max_dJ) << "," << full(r.ref_L) << ","
           << full(r.ref_J) << "," << status << "\n";
@@ -333,7 +377,14 @@ StudyResult run_study(const StudyOptions& o) {
     md << ") − reference‖₂, reference `" << ref_label << "` (its own error, estimated by Richardson from the finest "
        << "sweep run of the same scheme: " << sci(ref_error) << ").\n";
     md << "- cost: CPU seconds of each run (one core each, two runs at a time) and residual / right-hand-side "
-          "evaluations.\n\n";
+          "evaluations.\n";
+    if (o.max_wall_per_run > 0.0 || o.max_steps_per_run > 0)
+      md << "- per-run budget: " << (o.max_wall_per_run > 0.0 ? num(o.max_wall_per_run) + " s of wall time" : std::string())
+         << (o.max_wall_per_run > 0.0 && o.max_steps_per_run > 0 ? ", " : "")
+         << (o.max_steps_per_run > 0 ? std::to_string(o.max_steps_per_run) + " steps" : std::string())
+         << ". A run that hits it is listed as \"stopped at budget\" with the time it reached and what it cost; "
+            "it is not complete and is no point of the work–precision diagram.\n";
+    md << "\n";
     for (const auto& group : o.groups) {
       md << "## " << (group == "window" ? "Work–precision window, t ≤ " + num(p.window_t_end) + " s" : std::string("Full duration"))
          << "\n\n";
@@ -347,6 +398,10 @@ StudyResult run_study(const StudyOptions& o) {
           md << r.steps << " | " << r.rhs_evaluations << " | " << r.factorizations << " | " << num(r.cpu_s) << " | "
              << sci(r.energy_error) << " | " << sci(r.energy_error_after_loads) << " | " << sci(r.displacement_error) << " | " << sci(r.max_dL) << " | " << sci(r.max_dJ)
              << " | complete |\n";
+        else if (r.status == "stopped at budget")
+          md << r.steps << " | " << r.rhs_evaluations << " | " << r.factorizations << " | " << num(r.cpu_s)
+             << " | – | – | – | – | – | **stopped at budget** (" << r.stop_note << "), t reached = " << num(r.t_reached)
+             << " of " << num(r.t_end) << " s |\n";
         else
           md << "– | – | – | – | – | – | – | – | – | " << r.status << " |\n";
       }

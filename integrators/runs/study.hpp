@@ -12,6 +12,10 @@
 //   full/     the case's full duration: every fixed-step scheme at full_dt and the cheapest baseline.
 // Resumable: a run whose <group>/<label>/run.json says "status": "complete" is not run again (delete its
 // folder, or pass rerun, to repeat it); only the missing runs go to run_comparison().
+// Per-run budget (max_wall_per_run / max_steps_per_run, the run driver's --max-wall / --max-steps): a run
+// that hits it stops at its next output time and is a row "stopped at budget" with the time it reached —
+// never a complete row, never a point of the work–precision diagram or the headline. It is kept on resume
+// while the budget is not raised (a larger budget, no budget or rerun run it again from t = 0).
 //
 // Measures per run (study.csv / study.md, from the run folders, so resumed runs count too):
 //   energy error  = energy balance max_t |H(t) − H(0)| / max_t (K + V)(t), H = K + V − W_ext (the exact flow keeps
@@ -31,6 +35,7 @@
 
 #include <ostream>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace shelldyn {
@@ -65,6 +70,8 @@ struct StudyOptions {
   std::vector<std::string> groups = {"window", "full"};
   bool rerun = false;                     // true: run completed runs again
   bool dry_run = false;                   // true: list the runs (and which are done), run nothing
+  double max_wall_per_run = 0.0;          // per-run budget in wall seconds (0: none; see above)
+  long long max_steps_per_run = 0;        // per-run budget in steps, checked at output times (0: none)
   CompareOptions execution;               // jobs / threads / executor handed to run_comparison() (MPI: every rank
                                           // calls run_study; only the one with report = true writes the tables)
   bool report = true;
@@ -75,7 +82,9 @@ struct StudyOptions {
 struct StudyRow {
   std::string group, label, integrator, kind;  // kind: fixed | adaptive | reference | baseline
   double dt = 0.0, rtol = 0.0;            // the swept parameter (0 where not applicable)
-  std::string status;                     // "complete", "failed: ...", "not run"
+  std::string status;                     // "complete", "stopped at budget", "failed: ...", "not run"
+  std::string stop_note;                  // stopped at budget: the run driver's message (run.json "status")
+  double t_reached = 0.0;                 // last output time in history.csv (= t_end when complete)
   long steps = 0, rhs_evaluations = 0, factorizations = 0, nonlinear_iterations = 0;
   double cpu_s = 0.0, wall_s = 0.0;
   double energy_error = 0.0, energy_error_after_loads = 0.0, displacement_error = 0.0, max_dL = 0.0, max_dJ = 0.0, ref_L = 0.0, ref_J = 0.0;
@@ -84,7 +93,7 @@ struct StudyRow {
 
 struct StudyResult {
   std::vector<StudyRow> rows;
-  int ran = 0, skipped = 0, failed = 0;
+  int ran = 0, skipped = 0, failed = 0, stopped = 0;  // stopped: at the per-run budget (not failed)
   std::string study_csv, study_md;
 };
 
@@ -93,5 +102,8 @@ StudyResult run_study(const StudyOptions& options);
 // The value of "key" in the "summary" object of a run.json (NaN if absent), and its "status".
 double run_json_number(const std::string& run_json_text, const std::string& key);
 std::string run_json_status(const std::string& run_json_text);
+// The budget a run.json status "stopped: --max-wall S s reached ..." / "stopped: --max-steps N reached ..."
+// names: {"max-wall", S} or {"max-steps", N}; {"", 0} for any other status.
+std::pair<std::string, double> stopped_budget(const std::string& status);
 
 }  // namespace shelldyn

@@ -8,6 +8,8 @@ reports as skipped) and runs CASE into it, once for each file that is to fill th
   vtu         VTU every output (fields/step_*.vtu is the largest file)
   history     no VTU, many output rows (history.csv grows until the disk is full)
   checkpoint  no VTU, a checkpoint every step (checkpoint.cbor.tmp)
+  static_vtu  `shelldyn static` of apps/cases/sze-cantilever-shear.yaml, a VTU every increment
+  static_csv  the same without VTU and with 2000 increments (static.csv grows until the disk is full)
 Each run must exit 1 with a first stderr line "shelldyn: error: PATH: ... the disk is full ..." naming
 the file named for the scenario, and leave:
   - run.json with status "incomplete: " + that same message (not "incomplete: running", not "complete");
@@ -22,12 +24,18 @@ import subprocess
 import sys
 import xml.etree.ElementTree as ET
 
+STATIC_CASE = "sze-cantilever-shear.yaml"  # beside CASE in apps/cases
 SCENARIOS = {
-    # name: (tmpfs size, extra run arguments, failing file must contain)
+    # name: (tmpfs size, extra run arguments, failing file must contain); "static_*": `shelldyn static` on
+    # STATIC_CASE, the extra "arguments" are (old, new) replacements of its text.
     "vtu": ("160k", ["--t-end", "2", "--output-every", "0.01", "--vtu-every", "1"], "/fields/step_"),
     "history": ("160k", ["--t-end", "20", "--output-every", "0.01", "--vtu-every", "0"], "/history.csv"),
     "checkpoint": ("160k", ["--t-end", "2", "--output-every", "0.01", "--vtu-every", "0", "--checkpoint-every", "1"],
                    "/checkpoint.cbor"),
+    "static_vtu": ("160k", [], "/fields"),  # a VTU or fields.pvd, whichever meets the full disk
+    "static_csv": ("160k", [("output: {vtu: true, vtu_every: 1, history: false}", "output: {vtu: false}"),
+                            ("integrator: {name: static}", "integrator: {name: static, increment: 0.0005, growth: 1.0, max_steps: 5000}")],
+                   "/static.csv"),
 }
 
 
@@ -47,8 +55,18 @@ def check(exe, case, mnt, name):
         skip("cannot mount a tmpfs here")
     try:
         out = os.path.join(mnt, "out")
-        r = subprocess.run([exe, "run", case, "--dt", "0.01", "--threads", "1", "-q", "-o", out] + extra,
-                           capture_output=True, text=True, timeout=600)
+        if name.startswith("static"):
+            text = open(os.path.join(os.path.dirname(case), STATIC_CASE)).read()
+            for old, new in extra:
+                if old not in text:
+                    fail(f"{name}: {STATIC_CASE} no longer holds {old!r}")
+                text = text.replace(old, new)
+            static_case = os.path.join(os.path.dirname(mnt), "static_case.yaml")
+            open(static_case, "w").write(text)
+            cmd = [exe, "static", static_case, "-o", out]
+        else:
+            cmd = [exe, "run", case, "--dt", "0.01", "--threads", "1", "-q", "-o", out] + extra
+        r = subprocess.run(cmd, capture_output=True, text=True, timeout=600)
         first = r.stderr.splitlines()[0] if r.stderr else ""
         if r.returncode != 1:
             fail(f"{name}: exit code {r.returncode}, expected 1; stderr: {r.stderr!r}")
@@ -64,15 +82,17 @@ def check(exe, case, mnt, name):
             left += [os.path.join(root, f) for f in files if f.endswith(".tmp") or f == "run.json.reserve"]
         if left:
             fail(f"{name}: left behind: {left}")
-        hist = os.path.join(out, "history.csv")
-        if os.path.exists(hist):
+        for table in ("history.csv", "static.csv"):
+            hist = os.path.join(out, table)
+            if not os.path.exists(hist):
+                continue
             lines = open(hist).read().split("\n")
-            if lines[-1] != "":
-                fail(f"{name}: history.csv ends in a half row: {lines[-1][:80]!r}")
+            if name != "static_csv" and lines[-1] != "":  # a full disk may cut static.csv's last row
+                fail(f"{name}: {table} ends in a half row: {lines[-1][:80]!r}")
             width = lines[0].count(",")
             bad = [i for i, l in enumerate(lines[1:-1], 2) if l.count(",") != width]
             if bad:
-                fail(f"{name}: history.csv rows {bad[:5]} are not whole")
+                fail(f"{name}: {table} rows {bad[:5]} are not whole")
         listed = set()
         pvd = os.path.join(out, "fields.pvd")
         if os.path.exists(pvd):

@@ -85,6 +85,65 @@ TEST(Study, RunsMeasuresAndResumes) {
   fs::remove_all(dir);
 }
 
+std::string file_text(const std::string& path) {
+  std::ifstream in(path);
+  return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+}
+
+// A per-run step budget: runs that hit it are "stopped at budget" rows with the time they reached (never
+// complete, never failed), the others complete; a stopped reference measures nothing; resuming with the same
+// budget keeps them, without a budget they run again to the end.
+TEST(Study, StoppedAtBudgetIsReportedWithTheTimeReached) {
+  const std::string dir = testing::TempDir() + "/shelldyn-study-budget";
+  fs::remove_all(dir);
+  StudyOptions o = tiny_study(dir);
+  o.max_steps_per_run = 6;  // checked at the output times 0.01, 0.02, 0.03 (the last one, 0.04, completes the run)
+  const StudyResult first = run_study(o);
+  EXPECT_EQ(first.failed, 0);
+  EXPECT_EQ(first.stopped, 3);
+  const StudyRow& coarse = row(first, "em-galpha_dt=0.01");  // 4 steps: below the budget
+  EXPECT_EQ(coarse.status, "complete");
+  EXPECT_NEAR(coarse.t_reached, 0.04, 1e-12);
+  EXPECT_TRUE(std::isnan(coarse.displacement_error));  // the reference did not complete
+  const StudyRow& fine = row(first, "em-galpha_dt=0.005");  // 2 steps per output: 6 at t = 0.03
+  EXPECT_EQ(fine.status, "stopped at budget");
+  EXPECT_EQ(fine.steps, 6);
+  EXPECT_NEAR(fine.t_reached, 0.03, 1e-12);
+  EXPECT_NE(fine.stop_note.find("--max-steps 6"), std::string::npos) << fine.stop_note;
+  EXPECT_TRUE(std::isnan(fine.energy_error));
+  EXPECT_EQ(row(first, "em-galpha_dt=0.00125").status, "stopped at budget");
+  EXPECT_NEAR(row(first, "em-galpha_dt=0.00125").t_reached, 0.01, 1e-12);
+  EXPECT_EQ(row(first, "ida-bdf_rtol=0.0001").status, "stopped at budget");
+  const std::string md = file_text(first.study_md);
+  EXPECT_NE(md.find("per-run budget: 6 steps"), std::string::npos);
+  EXPECT_NE(md.find("**stopped at budget** (stopped: --max-steps 6 reached), t reached = 0.03 of 0.04 s"), std::string::npos) << md;
+  EXPECT_EQ(md.find("No baseline"), std::string::npos);
+  const std::string csv = file_text(first.study_csv);
+  EXPECT_NE(csv.find(",stopped at budget (stopped: --max-steps 6 reached)\n"), std::string::npos) << csv;
+
+  const StudyResult again = run_study(o);  // same budget: nothing runs
+  EXPECT_EQ(again.ran, 0);
+  EXPECT_EQ(again.skipped, 4);
+  EXPECT_EQ(again.stopped, 3);
+
+  o.max_steps_per_run = 0;  // no budget: the three stopped runs run again, to the end
+  const StudyResult last = run_study(o);
+  EXPECT_EQ(last.ran, 3);
+  EXPECT_EQ(last.stopped, 0);
+  for (const auto& r : last.rows) EXPECT_EQ(r.status, "complete") << r.label;
+  EXPECT_GT(row(last, "em-galpha_dt=0.01").displacement_error, 0.0);
+  fs::remove_all(dir);
+}
+
+TEST(Study, StoppedBudgetParsing) {
+  EXPECT_EQ(stopped_budget("stopped: --max-wall 300 s reached at t = 0.1 of 1 (step 7)"),
+            (std::pair<std::string, double>{"max-wall", 300.0}));
+  EXPECT_EQ(stopped_budget("stopped: --max-steps 6 reached at t = 0.03 of 0.04 (step 6)"),
+            (std::pair<std::string, double>{"max-steps", 6.0}));
+  EXPECT_EQ(stopped_budget("complete").first, "");
+  EXPECT_EQ(stopped_budget("interrupted: SIGINT at t = 1").first, "");
+}
+
 TEST(Study, BadPresetFailsBeforeAnyRun) {
   const std::string dir = testing::TempDir() + "/shelldyn-study-bad";
   fs::remove_all(dir);
