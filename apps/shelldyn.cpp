@@ -169,12 +169,21 @@ int run_check(const CheckOptions& o) {
   const CaseSpec spec = load_case(o.case_path);
   validate_case_integrator(spec);  // exactly as `run` will (FILE:LINE: integrator.KEY: ...)
   const Discretization d = build_discretization(spec);
+  VtuFields fields = initial_fields(d);
+  if (!spec.initial_displacement.empty()) {  // validate it as `run` will, and show the displaced state
+    const Problem pb = make_problem(spec);
+    const State s = pb.initial_state();
+    const VtuFields displaced = state_fields(*pb.model, s);
+    fields.displacement = displaced.displacement;
+    fields.director = displaced.director;
+    fields.point_scalars.front() = displaced.point_scalars.front();  // director_rate
+  }
   const fs::path dir = o.out_dir.empty() ? fs::path("results") / spec.name : fs::path(o.out_dir);
   app::prepare_result_folder(dir.string(), o.overwrite);
   print_summary(std::cout, spec, d);
   prepare_output_folder(dir.string());
   const std::string vtu = "fields/" + vtu_step_file_name(0);
-  write_vtu((dir / vtu).string(), d.mesh, initial_fields(d));
+  write_vtu((dir / vtu).string(), d.mesh, fields);
   PvdWriter pvd((dir / "fields.pvd").string());
   pvd.add(0.0, vtu);
 

@@ -118,6 +118,71 @@ CorotationalFrame::Vec45 CorotationalFrame::local_variables(const std::array<Eig
   return u;
 }
 
+namespace {
+
+// Error-free transformations (Knuth's TwoSum; TwoProduct by FMA when the target has it, else Dekker's
+// splitting): a op b = hi + lo exactly in binary64. Used by the compensated local translations below.
+struct DD {
+  double hi = 0.0, lo = 0.0;
+};
+
+inline DD two_sum(double a, double b) {
+  const double s = a + b;
+  const double bb = s - a;
+  return {s, (a - (s - bb)) + (b - bb)};
+}
+
+inline DD two_prod(double a, double b) {
+  const double p = a * b;
+#ifdef __FMA__
+  return {p, std::fma(a, b, -p)};
+#else
+  constexpr double split = 134217729.0;  // 2^27 + 1
+  const double ca = split * a, cb = split * b;
+  const double ah = ca - (ca - a), bh = cb - (cb - b);
+  const double al = a - ah, bl = b - bh;
+  return {p, ((ah * bh - p) + ah * bl + al * bh) + al * bl};
+#endif
+}
+
+// (hi, lo) + (b_hi, b_lo), renormalised.
+inline DD dd_add(const DD& a, const DD& b) {
+  const DD s = two_sum(a.hi, b.hi);
+  return two_sum(s.hi, s.lo + a.lo + b.lo);
+}
+
+}  // namespace
+
+CorotationalFrame::Vec45 CorotationalFrame::local_variables(const std::array<Eigen::Vector3d, 9>& x_local0,
+                                                          const std::array<Eigen::Vector3d, 9>& rel_ref,
+                                                          const std::array<Eigen::Vector3d, 9>& disp) const {
+  // d_O = ¼ Σ corners, in double-double.
+  std::array<DD, 3> dO;
+  for (int c = 0; c < 3; ++c) {
+    DD acc;
+    for (int k = 0; k < 4; ++k) acc = dd_add(acc, {disp[k](c), 0.0});
+    dO[c] = {0.25 * acc.hi, 0.25 * acc.lo};  // exact scaling by a power of two
+  }
+  Vec45 u;
+  for (int i = 0; i < 9; ++i) {
+    // rel_i = (X_i - X_O) + (d_i - d_O), exact to double-double.
+    std::array<DD, 3> rel;
+    for (int c = 0; c < 3; ++c)
+      rel[c] = dd_add(dd_add({rel_ref[i](c), 0.0}, {disp[i](c), 0.0}), {-dO[c].hi, -dO[c].lo});
+    for (int r = 0; r < 3; ++r) {
+      DD acc{-x_local0[i](r), 0.0};
+      for (int c = 0; c < 3; ++c) {
+        const DD p = two_prod(R_(c, r), rel[c].hi);
+        acc = dd_add(acc, {p.hi, p.lo + R_(c, r) * rel[c].lo});
+      }
+      u(5 * i + r) = acc.hi + acc.lo;
+    }
+    u(5 * i + 3) = R_.col(0).dot(p_[i]);
+    u(5 * i + 4) = R_.col(1).dot(p_[i]);
+  }
+  return u;
+}
+
 CorotationalFrame::Vec45 CorotationalFrame::apply_transpose(const Vec45& fL) const {
   derivatives();
   Vec45 F;

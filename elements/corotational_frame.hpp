@@ -36,6 +36,15 @@ class CorotationalFrame {
 
   // Local variables (§3.2): t_i = R^T(x_i - x_O) - x_i0 and θ_i (absolute, not the increment).
   Vec45 local_variables(const std::array<Eigen::Vector3d, 9>& x_local0) const;
+  // The same, with t_i evaluated in compensated (double-double) arithmetic from the reference offsets
+  // X_i - X_O and the displacements d_i, x_i = X_i + d_i (docs/theory/exact-energy-momentum.md §5.1).
+  // t_i is a strain-sized difference of body-sized numbers: in plain double arithmetic it carries an
+  // absolute error of ~1e-16 × the element's distance from x_O, which the membrane stiffness turns into a
+  // force noise floor. Here only the rounding of the result remains (~1e-16 |t_i|). R is the frame's triad
+  // as computed; its own rounding is an infinitesimal rigid rotation of the local configuration, to which
+  // the local strains are insensitive to first order.
+  Vec45 local_variables(const std::array<Eigen::Vector3d, 9>& x_local0, const std::array<Eigen::Vector3d, 9>& rel_ref,
+                        const std::array<Eigen::Vector3d, 9>& disp) const;
 
   // F_G = T^T f_L (§3.4).
   Vec45 apply_transpose(const Vec45& fL) const;

@@ -114,7 +114,8 @@ CR9Shell::CR9Shell(const std::array<Eigen::Vector3d, 9>& X0, const std::array<Ei
   std::array<Eigen::Vector3d, 9> r0;
   std::array<Eigen::Matrix<double, 3, 2>, 9> L;
   for (int i = 0; i < 9; ++i) {
-    xl0_[i] = R0.transpose() * (X0[i] - xO);
+    rel0_[i] = X0[i] - xO;
+    xl0_[i] = R0.transpose() * rel0_[i];
     r0[i] = R0.transpose() * p0[i];
     // §2.4 orientation requirement: r_i0,z = e_z0·p_i0 > 0.
     if (!(r0[i](2) > 0.0)) {
@@ -256,7 +257,9 @@ CorotationalFrame CR9Shell::local_increments(const Vec45& u, const Charts& chart
   }
   CorotationalFrame fr(x, p, A1, d2, charts);
   if (w) {
-    *w = fr.local_variables(xl0_);
+    std::array<Eigen::Vector3d, 9> d;
+    for (int i = 0; i < 9; ++i) d[i] = u.segment<3>(5 * i);
+    *w = fr.local_variables(xl0_, rel0_, d);  // compensated t_i (docs/theory/exact-energy-momentum.md §5.1)
     for (int i = 0; i < 9; ++i) w->segment<2>(5 * i + 3) -= th0_[i];  // Δθ_i = θ_i - θ_i0 (§2.5)
   }
   return fr;

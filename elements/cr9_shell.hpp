@@ -131,6 +131,7 @@ class CR9Shell {
 
   std::array<Eigen::Vector3d, 9> X0_;
   std::array<Eigen::Vector3d, 9> xl0_;  // initial local coordinates x_i0 (§3.2)
+  std::array<Eigen::Vector3d, 9> rel0_;  // X_i - X_O, the reference offsets of the compensated t_i
   std::array<Eigen::Vector2d, 9> th0_;  // θ_i0 = (r_i0,x, r_i0,y)
   ShellMaterial mat_;
   Options opt_;

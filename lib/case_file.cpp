@@ -7,6 +7,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -587,7 +588,7 @@ std::vector<MonitorSpec> parse_monitors(const Parser& p, const YAML::Node& n) {
 CaseSpec parse_document(const Parser& p, const YAML::Node& root, const std::string& base_dir) {
   if (!root.IsDefined() || root.IsNull()) p.fail(root, "", "the case file is empty (see apps/cases/ for examples)");
   p.check_keys(root, "",
-               {"name", "description", "mesh", "material", "sets", "boundary_conditions", "initial_velocity", "loads",
+               {"name", "description", "mesh", "material", "sets", "boundary_conditions", "initial_velocity", "initial_displacement", "loads",
                 "damping", "integrator", "time", "output", "monitors"},
                {"mesh", "material", "integrator", "time"});
   CaseSpec c;
@@ -618,6 +619,26 @@ CaseSpec parse_document(const Parser& p, const YAML::Node& root, const std::stri
     } else {
       c.initial_velocity = parse_initial_velocity(p, iv, "initial_velocity", base_dir);
     }
+  }
+  if (root["initial_displacement"]) {  // docs/manual.md §2.6
+    const YAML::Node id = root["initial_displacement"];
+    if (!id.IsMap()) p.fail(id, "initial_displacement", "expected a mapping {field: FILE.vtu}, got a " + node_kind(id));
+    p.check_keys(id, "initial_displacement", {"field"}, {"field"});
+    fs::path file(p.string(id["field"], "initial_displacement.field"));
+    std::string ext = file.extension().string();
+    for (char& ch : ext) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
+    if (ext != ".vtu")
+      p.fail(id["field"], "initial_displacement.field",
+             "'" + file.string() + "' is not a .vtu file: give a fields/step_NNNNNN.vtu written by shelldyn");
+    if (file.is_relative()) file = fs::path(base_dir) / file;
+    c.initial_displacement = file.lexically_normal().string();
+    c.initial_displacement_where = p.where(id, "initial_displacement.field");
+    const auto rigid_or_mode = [](const InitialVelocitySpec& v) { return v.given && v.field.empty(); };
+    bool bad = rigid_or_mode(c.initial_velocity);
+    for (const auto& e : c.initial_velocity_more) bad = bad || rigid_or_mode(e);
+    if (bad)
+      p.fail(id, "initial_displacement",
+             "the initial velocity must then be a field (e.g. the same VTU), not a rigid motion or mode");
   }
   if (root["loads"]) c.loads = parse_loads(p, root["loads"]);
   if (root["damping"]) c.damping = parse_damping(p, root["damping"]);

@@ -28,6 +28,7 @@
 //   initial_velocity: {[set = all], [translation], [angular], [about: centroid | [x,y,z]] | [field: v.csv | fields/step_N.vtu]
 //                      | [mode: mode_shapes.csv, index: k, amplitude: A]}
 //                     or a list of such entries (later ones override earlier ones)         optional
+//   initial_displacement: {field: fields/step_N.vtu}  (displacement and director of a run)  optional
 //   loads: [{set, type: force|moment, direction, amplitude, [distribution: per_node|edge_total|per_length],
 //            [function: {type: constant|ramp|hat|triangle|table, ...}]}
 //          | {[set = all], type: pressure|follower_pressure, amplitude, [function]}
@@ -226,6 +227,10 @@ struct CaseSpec {
   std::vector<BoundaryConditionSpec> boundary_conditions;
   InitialVelocitySpec initial_velocity;                 // the mapping form, or the first entry of the list form
   std::vector<InitialVelocitySpec> initial_velocity_more;  // further entries of the list form
+  // initial_displacement: {field: FILE.vtu}: the displacements and directors of a VTU written by shelldyn
+  // (docs/manual.md §2.6); empty: the reference configuration.
+  std::string initial_displacement;
+  std::string initial_displacement_where;
   std::vector<LoadSpec> loads;
   DampingSpec damping;
   IntegratorSpec integrator;

@@ -365,6 +365,7 @@ Discretization build_discretization(const CaseSpec& spec) {
   // Initial velocity (docs/manual.md §2.6): rigid-body fields v = v0 + ω × (X − about), ṗ = ω × p
   // (docs/benchmarks.md §6) on sets, or nodal values from a CSV file; later entries override earlier ones.
   d.initial_velocity = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(n) * kDofsPerNode);
+  d.initial_director_rate.assign(static_cast<size_t>(n), Vec3::Zero());
   std::vector<const InitialVelocitySpec*> parts;
   if (spec.initial_velocity.given) parts.push_back(&spec.initial_velocity);
   for (const auto& e : spec.initial_velocity_more) parts.push_back(&e);
@@ -384,6 +385,7 @@ Discretization build_discretization(const CaseSpec& spec) {
         const Vec3 pdot = vel.tail<3>() - vel.tail<3>().dot(d.normals[si]) * d.normals[si];  // tangent to p
         d.initial_velocity.segment<3>(base) = vel.head<3>();
         d.initial_velocity.segment<2>(base + 3) = chart_coordinates(pdot, d.charts[si]);
+        d.initial_director_rate[si] = vel.tail<3>();
         scale = std::max(scale, vel.norm());
       }
     } else {
@@ -401,6 +403,7 @@ Discretization build_discretization(const CaseSpec& spec) {
         const Eigen::Index base = static_cast<Eigen::Index>(DofMap::dof(i, 0));
         d.initial_velocity.segment<3>(base) = v;
         d.initial_velocity.segment<2>(base + 3) = qdot;
+        d.initial_director_rate[si] = iv.angular.cross(d.normals[si]);
       }
     }
     // A prescribed DOF cannot start moving: refuse instead of silently zeroing the user's field.

@@ -50,6 +50,9 @@ struct Discretization {
   // 5 per node: [v_X, v_Y, v_Z, q̇_1, q̇_2] with v = translation + ω × (X − about), q̇ = S (ω × p_i0)
   // (S = 2x3 selector of the chart's minor components n, m). Zero if the case has no initial velocity.
   Eigen::VectorXd initial_velocity;
+  // The director rate ṗ of each node as given (3 per node, before the projection normal to p_i0): with an
+  // initial_displacement it is re-expressed for the displaced directors (Problem::initial_state).
+  std::vector<Vec3> initial_director_rate;
   std::vector<DiscreteLoad> loads;    // nodal forces/moments, incl. dead pressure, body force, edge loads
   std::vector<FollowerPressure> follower_pressures;  // evaluated on the current geometry by the Model
   double loads_end = 0.0;             // all loads vanish for t >= loads_end (+inf if some never do; 0 if none)

@@ -1,5 +1,7 @@
 #include "lib/problem.hpp"
 
+#include "lib/state_output.hpp"
+
 #include <stdexcept>
 
 namespace shelldyn {
@@ -28,6 +30,31 @@ Model make_model(const Discretization& d, const CaseMaterial& material) {
 
 State Problem::initial_state() const {
   State s = model->initial_state();
+  if (!spec.initial_displacement.empty()) {
+    // initial_displacement (docs/manual.md §2.6): d and p of a VTU, charts selected for those directors and
+    // adopted by the model (its director constraints follow the charts); t = 0 whatever the VTU's time.
+    bool has_time = false;
+    State d;
+    try {
+      d = state_from_vtu(*model, spec.initial_displacement, &has_time);
+    } catch (const std::exception& e) {
+      throw std::runtime_error(spec.initial_displacement_where + ": " + e.what());
+    }
+    s.u = d.u;
+    s.charts = d.charts;
+    model->adopt_charts(s.charts);
+    // The initial velocity: translations as given; director rates made normal to the displaced directors and
+    // expressed in their charts (only fields are allowed with an initial displacement: case_file.cpp).
+    for (int i = 0; i < model->mesh().num_nodes(); ++i) {
+      const size_t si = static_cast<size_t>(i);
+      const Eigen::Index k = static_cast<Eigen::Index>(DofMap::dof(i, 0));
+      if (disc.initial_velocity.size() == s.v.size()) s.v.segment<3>(k) = disc.initial_velocity.segment<3>(k);
+      const Vec3 p = model->director(s, i);
+      const Vec3 w = si < disc.initial_director_rate.size() ? disc.initial_director_rate[si] : Vec3::Zero();
+      s.v.segment<2>(k + 3) = chart_coordinates(w - w.dot(p) * p, s.charts[si]);
+    }
+    return s;
+  }
   if (disc.initial_velocity.size() == s.v.size()) s.v = disc.initial_velocity;
   return s;
 }
@@ -42,6 +69,7 @@ Problem make_problem(CaseSpec spec) {
   } catch (const std::exception& e) {
     throw std::runtime_error(p.spec.source + ": " + e.what());
   }
+  if (!p.spec.initial_displacement.empty()) (void)p.initial_state();  // a bad VTU is a case error, found now
   return p;
 }
 

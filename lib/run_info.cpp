@@ -179,6 +179,7 @@ std::string run_json(const CaseSpec& c, const RunInfo& info) {
   iv["translation"] = vec3(c.initial_velocity.translation);
   iv["angular"] = vec3(c.initial_velocity.angular);
   iv["about"] = c.initial_velocity.about_centroid ? Json("centroid") : vec3(c.initial_velocity.about);
+  if (!c.initial_displacement.empty()) cs["initial_displacement"] = {{"field", c.initial_displacement}};
   Json& loads = cs["loads"] = Json::array();
   for (const auto& l : c.loads) {
     Json f = {{"type", l.function.kind_name()}};

@@ -85,6 +85,7 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
     c.scalars["diag_max_residual"] = diag_.max_residual;
     c.scalars["diag_max_beta_z"] = diag_.max_beta_z;
     c.scalars["diag_rigid_guards"] = static_cast<double>(diag_.rigid_guards);
+    c.scalars["diag_residual_work"] = diag_.residual_work;
     const int since = nopt_.modified ? newton_->iterations_since_setup() : -1;
     c.scalars["newton_since_setup"] = since;
     if (since >= 0) c.vectors["kbar"] = Eigen::Map<const Eigen::VectorXd>(kbar_.data(), static_cast<Index>(kbar_.size()));
@@ -106,6 +107,7 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
     diag_.max_residual = c.scalar("diag_max_residual");
     diag_.max_beta_z = c.scalar("diag_max_beta_z");
     diag_.rigid_guards = static_cast<long>(c.scalar("diag_rigid_guards"));
+    diag_.residual_work = c.scalars.count("diag_residual_work") ? c.scalar("diag_residual_work") : 0.0;
     const int since = static_cast<int>(c.scalar("newton_since_setup"));
     replay_kbar_ = false;
     if (nopt_.modified && since >= 0) {
@@ -266,6 +268,7 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
       if (rel < best) {
         best = rel;
         best_u_ = u;
+        best_r_ = r;
       }
     };
     bool replayed = false;
@@ -304,6 +307,7 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
 
     Eigen::VectorXd u = un_;  // predictor u_{n+1} = u_n (theory §5)
     best_u_ = u;
+    best_r_.setZero(n);
     const NewtonSolver::Result r = newton.solve(u.data(), residual, jacobian, nullptr, nullptr, hook);
     if (full_newton) newton_->invalidate_jacobian();
     rep.nonlinear_iterations += r.iterations;
@@ -334,6 +338,7 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
       diag_.min_step_dissipation = std::min(diag_.min_step_dissipation, 0.0);
     }
     diag_.max_residual = std::max(diag_.max_residual, best);
+    diag_.residual_work += (u - un_).dot(best_r_);  // constrained rows of r are zero
     // External work as the scheme evaluates it (theory §4): F_ext(t_mid)·Δd + Σ g_i·Δp_i.
     double dw = g_.dot(p1_ - pn_);
     for (int i = 0; i < nn_; ++i) {
@@ -375,7 +380,7 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
   SparseMatrix M_, K_;
   std::vector<CR9Shell::Mat45> k0_;
   std::vector<double> Un_;
-  Eigen::VectorXd un_, umid_, fint_, r_, best_u_;
+  Eigen::VectorXd un_, umid_, fint_, r_, best_u_, best_r_;
   Eigen::VectorXd vn_, wn_, pn_, p1_, pmid_, v1_, w1_, mv_, mw_, fd_, g_;
   double work_ = 0.0;
   double last_h_ = 0.0;

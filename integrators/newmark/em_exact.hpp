@@ -38,6 +38,9 @@ class EmExactDiagnostics {
     double max_residual = 0.0;      // largest accepted scaled residual of any step
     double max_beta_z = 0.0;        // largest relative size of the energy correction β z
     long rigid_guards = 0;          // element-steps treated as rigid (β = 0)
+    // Σ over steps of Δuᵀr, the work of the Newton residual r at the accepted iterate. By the energy
+    // identity (docs/theory/exact-energy-momentum.md §4) this is the whole change of K + V + D − W_ext.
+    double residual_work = 0.0;
   };
   virtual const Data& diagnostics() const = 0;
 };

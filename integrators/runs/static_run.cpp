@@ -156,7 +156,8 @@ std::vector<StaticRow> run_static(Problem& problem, const std::string& out_dir, 
     rows.push_back(std::move(row));
   };
 
-  State state = model.initial_state();
+  State state = problem.initial_state();  // the reference state, or the case's initial_displacement
+  state.v.setZero();                      // statics: velocities play no part
   if (start) {  // a saved state (shelldyn static --state): its configuration at load factor start->t
     if (start->u.size() != state.u.size() || start->charts.size() != state.charts.size())
       throw std::invalid_argument("the start state has " + std::to_string(start->u.size()) + " DOFs, this case's model " +

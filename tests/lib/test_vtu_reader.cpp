@@ -211,3 +211,42 @@ TEST(VtuReader, StateFromAVtuOfARun) {
   // The static continuation of the unconstrained panel is still accepted (only the translations differ).
   EXPECT_NO_THROW(state_from_vtu(model, vtu, &has_time));
 }
+
+// initial_displacement: {field: FILE.vtu} (docs/manual.md §2.6): the run starts from the VTU's displacements
+// and directors; with initial_velocity: {field: same.vtu} the whole state of the VTU comes back, so K, V, L,
+// J are those of the written state. Only velocity fields go with it; a bad VTU is a case error.
+TEST(VtuReader, InitialDisplacementAndVelocityFromAVtu) {
+  Problem pb = panel();
+  const State s = moving_state(*pb.model);
+  const fs::path dir = scratch_dir("initial_displacement");
+  const std::string vtu = (dir / "fields" / "step_000002.vtu").string();
+  write_vtu(vtu, pb.model->mesh(), state_fields(*pb.model, s));
+  Problem b = panel("initial_displacement: {field: " + vtu + "}\ninitial_velocity: {field: " + vtu + "}\n");
+  const State r = b.initial_state();
+  EXPECT_EQ(r.t, 0.0);
+  EXPECT_LE((r.u - s.u).cwiseAbs().maxCoeff(), 1e-15);
+  EXPECT_LE((r.v - s.v).cwiseAbs().maxCoeff(), 1e-14);
+  const Invariants a = pb.model->invariants(s), c = b.model->invariants(r);
+  ASSERT_GT(a.strain, 0.0);
+  EXPECT_NEAR(c.kinetic, a.kinetic, 1e-13 * a.kinetic);
+  EXPECT_NEAR(c.strain, a.strain, 1e-12 * a.strain);
+  EXPECT_LE((c.L - a.L).norm(), 1e-13 * a.L.norm());
+  EXPECT_LE((c.J - a.J).norm(), 1e-13 * a.J.norm());
+  // Displacement only: at rest in the displaced configuration.
+  Problem only = panel("initial_displacement: {field: " + vtu + "}\n");
+  EXPECT_EQ(only.initial_state().v.cwiseAbs().maxCoeff(), 0.0);
+  EXPECT_NEAR(only.model->invariants(only.initial_state()).strain, a.strain, 1e-12 * a.strain);
+  // Errors: a rigid initial velocity with it, not a VTU, a VTU of another mesh (named with the case line).
+  EXPECT_NE(error_of([&] { panel("initial_displacement: {field: " + vtu + "}\ninitial_velocity: {translation: [1, 0, 0]}\n"); })
+                .find("initial_displacement: the initial velocity must then be a field"),
+            std::string::npos);
+  EXPECT_NE(error_of([&] { panel("initial_displacement: {field: d.csv}\n"); }).find("is not a .vtu file"), std::string::npos);
+  Problem big = make_problem(load_case_from_string(
+      "mesh: {generator: cylindrical_panel, radius: 1.0, angle: 1.2, length: 1.5, n_arc: 3, n_axial: 2}\n"
+      "material: {E: 1.0e6, nu: 0.3, rho: 2, thickness: 0.05}\nintegrator: {name: em-galpha}\ntime: {dt: 0.1, t_end: 1}\n",
+      "big.yaml"));
+  write_vtu((dir / "big.vtu").string(), big.model->mesh(), state_fields(*big.model, big.initial_state()));
+  const std::string e = error_of([&] { panel("initial_displacement: {field: " + (dir / "big.vtu").string() + "}\n"); });
+  EXPECT_EQ(e.rfind("panel.yaml:", 0), 0u) << e;
+  EXPECT_NE(e.find("initial_displacement.field: " + (dir / "big.vtu").string() + ": has 35 points"), std::string::npos) << e;
+}
