@@ -184,23 +184,14 @@ CorotationalFrame::Vec45 CorotationalFrame::local_variables(const std::array<Eig
 }
 
 CorotationalFrame::Vec45 CorotationalFrame::apply_transpose(const Vec45& fL) const {
-  derivatives();
+  corner_columns();
   Vec45 F;
-  // Corner part Cᵀ f_L without forming C (§3.3): Σ_i of the corner blocks applied to f_L is
-  // −¼ R Σ_i f_t,i + Σ_α E_α,kᵀ w_α with the weight vectors of add_geometric_stiffness().
-  Eigen::Vector3d wx = Eigen::Vector3d::Zero(), wy = Eigen::Vector3d::Zero(), wz = Eigen::Vector3d::Zero(),
-                  ft = Eigen::Vector3d::Zero();
   for (int i = 0; i < 9; ++i) {
     F.segment<3>(5 * i) = R_ * fL.segment<3>(5 * i);
     F.segment<2>(5 * i + 3) = D_theta_[i].transpose() * fL.segment<2>(5 * i + 3);
-    wx += fL(5 * i) * rel_[i] + fL(5 * i + 3) * p_[i];
-    wy += fL(5 * i + 1) * rel_[i] + fL(5 * i + 4) * p_[i];
-    wz += fL(5 * i + 2) * rel_[i];
-    ft += fL.segment<3>(5 * i);
   }
-  const Eigen::Vector3d origin = -0.25 * (R_ * ft);
-  for (int k = 0; k < 4; ++k)
-    F.segment<3>(5 * k) += origin + E_[0][k].transpose() * wx + E_[1][k].transpose() * wy + E_[2][k].transpose() * wz;
+  const Eigen::Matrix<double, 12, 1> Fc = C_.transpose() * fL;
+  for (int k = 0; k < 4; ++k) F.segment<3>(5 * k) += Fc.segment<3>(3 * k);
   return F;
 }
 

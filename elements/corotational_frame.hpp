@@ -67,7 +67,7 @@ class CorotationalFrame {
     if (!have_derivatives_) compute_derivatives();
   }
   void compute_derivatives() const;
-  // The corner columns C of T (needed by tangent() and matrix(); apply_transpose() does without them).
+  // The corner columns C of T (apply_transpose(), tangent(), matrix()).
   void corner_columns() const {
     derivatives();
     if (!have_corner_columns_) compute_corner_columns();
