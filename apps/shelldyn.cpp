@@ -520,7 +520,7 @@ struct StudyCommandOptions {
   int jobs = 2;
   double max_wall_per_run = 0.0;
   long long max_steps_per_run = 0;
-  bool rerun = false, dry_run = false, no_plots = false;
+  bool rerun = false, dry_run = false, report_only = false, no_plots = false;
 };
 
 int run_study_command(const StudyCommandOptions& o) {
@@ -539,6 +539,7 @@ int run_study_command(const StudyCommandOptions& o) {
   so.max_steps_per_run = o.max_steps_per_run;
   so.rerun = o.rerun;
   so.dry_run = o.dry_run;
+  so.report_only = o.report_only;
   so.execution.jobs = o.jobs;
   so.log = &std::cout;
   so.command = o.command;
@@ -577,6 +578,9 @@ void add_study_command(CLI::App& app, Action& action, const std::string& command
                   "Budget per run in steps, checked at output times (default 0: none); reported as --max-wall-per-run");
   sub->add_flag("--rerun", o->rerun, "Run completed runs again (default: keep them; the study resumes)");
   sub->add_flag("--dry-run", o->dry_run, "List the runs and which are complete; run nothing");
+  sub->add_flag("--report-only", o->report_only,
+                "Run nothing; write study.csv, study.md and the plots from the run folders as they are (runs not made "
+                "are listed as not run)");
   sub->add_flag("--no-plots", o->no_plots, "Do not call scripts/plot_study.py");
   sub->callback([o, &action] { action = [o] { return run_study_command(*o); }; });
 }

@@ -133,7 +133,7 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
     full_newton_.reset();
     M_ = model_->make_matrix();
     K_ = M_;
-    for (Eigen::VectorXd* v : {&un_, &umid_, &fint_, &r_, &best_u_}) v->setZero(n);
+    for (Eigen::VectorXd* v : {&un_, &umid_, &fint_, &r_, &last_u_}) v->setZero(n);
     for (Eigen::VectorXd* v : {&vn_, &wn_, &pn_, &p1_, &pmid_, &v1_, &w1_, &mv_, &mw_, &fd_, &g_}) v->setZero(3 * nn_);
     work_ = 0.0;
     diag_ = Data{};
@@ -265,11 +265,12 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
       const double rn = r.cwiseAbs().maxCoeff();
       const double rel = rn == 0.0 ? 0.0 : rn / scale;
       history.push_back(rel);
-      if (rel < best) {
-        best = rel;
-        best_u_ = u;
-        best_r_ = r;
-      }
+      best = std::min(best, rel);
+      // The accepted iterate is the last one evaluated, not the one with the smallest residual: at the
+      // floor the smallest-residual iterate is usually an earlier one, still short of the solution on the
+      // predictor's side, and its residual's work Δuᵀr is one-signed (theory §5.1).
+      last_u_ = u;
+      last_r_ = r;
     };
     bool replayed = false;
     auto jacobian = [&](const double* up, SparseMatrix& J) {
@@ -306,8 +307,8 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
     };
 
     Eigen::VectorXd u = un_;  // predictor u_{n+1} = u_n (theory §5)
-    best_u_ = u;
-    best_r_.setZero(n);
+    last_u_ = u;
+    last_r_.setZero(n);
     const NewtonSolver::Result r = newton.solve(u.data(), residual, jacobian, nullptr, nullptr, hook);
     if (full_newton) newton_->invalidate_jacobian();
     rep.nonlinear_iterations += r.iterations;
@@ -315,14 +316,14 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
     rep.linear_setups += r.jacobian_evals - (replayed ? 1 : 0);
     rep.factorizations += r.factorizations - (replayed ? 1 : 0);
     rep.rhs_evaluations += r.residual_evals;
-    rep.residual_norm = best;
+    rep.residual_norm = history.empty() ? 0.0 : history.back();
     if (!r.converged) {
       std::ostringstream os;
       os << r.message << " (best scaled residual " << best << ", iterations = " << r.iterations << ")";
       *why = os.str();
       return false;
     }
-    u = best_u_;
+    u = last_u_;
     // Final quantities at the accepted iterate.
     kinematics(u, charts, h, tmid);
     if (xi_ > 0.0) {
@@ -337,8 +338,8 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
       diag_.rigid_guards += finfo.rigid_guards;
       diag_.min_step_dissipation = std::min(diag_.min_step_dissipation, 0.0);
     }
-    diag_.max_residual = std::max(diag_.max_residual, best);
-    diag_.residual_work += (u - un_).dot(best_r_);  // constrained rows of r are zero
+    diag_.max_residual = std::max(diag_.max_residual, rep.residual_norm);
+    diag_.residual_work += (u - un_).dot(last_r_);  // constrained rows of r are zero
     // External work as the scheme evaluates it (theory §4): F_ext(t_mid)·Δd + Σ g_i·Δp_i.
     double dw = g_.dot(p1_ - pn_);
     for (int i = 0; i < nn_; ++i) {
@@ -380,7 +381,7 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
   SparseMatrix M_, K_;
   std::vector<CR9Shell::Mat45> k0_;
   std::vector<double> Un_;
-  Eigen::VectorXd un_, umid_, fint_, r_, best_u_, best_r_;
+  Eigen::VectorXd un_, umid_, fint_, r_, last_u_, last_r_;
   Eigen::VectorXd vn_, wn_, pn_, p1_, pmid_, v1_, w1_, mv_, mw_, fd_, g_;
   double work_ = 0.0;
   double last_h_ = 0.0;

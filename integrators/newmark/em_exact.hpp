@@ -18,7 +18,7 @@
 // Newton too; a stop request (SIGINT, --max-wall) is honoured at the next step boundary.
 // Stopping (theory §5): the scaled residual ‖r‖∞ / (‖inertia‖∞ + ‖F*‖∞ + ‖F_ext‖∞) ≤ res_tol, or, once it is
 // below stall_tol, an iteration that does not reduce the best residual by stall_ratio (the round-off floor of
-// the co-rotational force); the best iterate is kept.
+// the co-rotational force); the last iterate is accepted (docs/theory/exact-energy-momentum.md §5.1).
 #pragma once
 
 #include "integrators/integrator.hpp"

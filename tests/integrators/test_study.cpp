@@ -126,6 +126,25 @@ TEST(Study, StoppedAtBudgetIsReportedWithTheTimeReached) {
   EXPECT_EQ(again.skipped, 4);
   EXPECT_EQ(again.stopped, 3);
 
+  // Report only: nothing runs (not even the stopped runs, which a call without a budget would repeat); a run
+  // whose run.json still says "running" (the study was killed during it) is "not run", not failed.
+  {
+    StudyOptions r = o;
+    r.max_steps_per_run = 0;
+    r.report_only = true;
+    const std::string ref_json = (fs::path(dir) / "window" / "em-galpha_dt=0.00125" / "run.json").string();
+    std::string text = file_text(ref_json);
+    text.replace(text.find("stopped: --max-steps"), 20, "incomplete: running ");
+    std::ofstream(ref_json) << text;
+    const StudyResult report = run_study(r);
+    EXPECT_EQ(report.ran, 0);
+    EXPECT_EQ(report.failed, 0);
+    EXPECT_EQ(report.stopped, 2);
+    EXPECT_EQ(row(report, "em-galpha_dt=0.00125").status, "not run (the study was stopped during this run)");
+    EXPECT_EQ(row(report, "em-galpha_dt=0.005").status, "stopped at budget");
+    EXPECT_NE(file_text(report.study_md).find("not run (the study was stopped during this run)"), std::string::npos);
+  }
+
   o.max_steps_per_run = 0;  // no budget: the three stopped runs run again, to the end
   const StudyResult last = run_study(o);
   EXPECT_EQ(last.ran, 3);
