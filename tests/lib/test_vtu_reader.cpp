@@ -240,7 +240,7 @@ TEST(VtuReader, InitialDisplacementAndVelocityFromAVtu) {
   EXPECT_NE(error_of([&] { panel("initial_displacement: {field: " + vtu + "}\ninitial_velocity: {translation: [1, 0, 0]}\n"); })
                 .find("initial_displacement: the initial velocity must then be a field"),
             std::string::npos);
-  EXPECT_NE(error_of([&] { panel("initial_displacement: {field: d.csv}\n"); }).find("is not a .vtu file"), std::string::npos);
+  EXPECT_NE(error_of([&] { panel("initial_displacement: {field: d.txt}\n"); }).find("is neither a .vtu nor a .csv file"), std::string::npos);
   Problem big = make_problem(load_case_from_string(
       "mesh: {generator: cylindrical_panel, radius: 1.0, angle: 1.2, length: 1.5, n_arc: 3, n_axial: 2}\n"
       "material: {E: 1.0e6, nu: 0.3, rho: 2, thickness: 0.05}\nintegrator: {name: em-galpha}\ntime: {dt: 0.1, t_end: 1}\n",
