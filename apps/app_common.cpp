@@ -6,6 +6,7 @@
 #include "integrators/integrator.hpp"
 #include "integrators/integrator_settings.hpp"
 #include "integrators/runs/run_driver.hpp"
+#include "lib/openmp_wait_policy.hpp"  // passive OpenMP waiting in every app (linked into each of them)
 #ifdef SHELLDYN_HAVE_MPI
 #include "integrators/runs/mpi_executor.hpp"
 #include "integrators/checkpoint/checkpoint.hpp"

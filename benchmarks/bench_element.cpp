@@ -5,6 +5,7 @@
 #include <Eigen/Geometry>
 #include <array>
 #include <random>
+#include <vector>
 
 #include "elements/cr9_shell.hpp"
 #include "elements/shape_functions.hpp"
@@ -77,6 +78,61 @@ void BM_AlgorithmicForceAndTangent(benchmark::State& state) {
   }
 }
 BENCHMARK(BM_AlgorithmicForceAndTangent)->Unit(benchmark::kMicrosecond);
+
+// What a residual of em-galpha costs per element: the strain-averaged force with the step's state at u_n
+// (computed once per step, outside the loop) and without a tangent.
+void BM_AlgorithmicForceStepState(benchmark::State& state) {
+  const Setup s = make_setup();
+  const CR9Shell e(s.X0, s.p0, kMat);
+  CR9Shell::StepState sn;
+  e.step_state(s.u, s.charts, &sn);
+  CR9Shell::Vec45 F;
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(e.algorithmic_internal(sn, s.u, s.u1, s.charts, 0.5, 0.0, &F, nullptr));
+    benchmark::ClobberMemory();
+  }
+}
+BENCHMARK(BM_AlgorithmicForceStepState)->Unit(benchmark::kMicrosecond);
+
+// The same over 256 element copies in turn (the hemisphere's count): element data streamed from memory as
+// in a model's residual, not hot in the cache. Time per element.
+void BM_AlgorithmicForceStepState256(benchmark::State& state) {
+  const Setup s = make_setup();
+  const std::vector<CR9Shell> els(256, CR9Shell(s.X0, s.p0, kMat));
+  std::vector<CR9Shell::StepState> sn(els.size());
+  for (size_t k = 0; k < els.size(); ++k) els[k].step_state(s.u, s.charts, &sn[k]);
+  CR9Shell::Vec45 F;
+  for (auto _ : state) {
+    for (size_t k = 0; k < els.size(); ++k)
+      benchmark::DoNotOptimize(els[k].algorithmic_internal(sn[k], s.u, s.u1, s.charts, 0.5, 0.0, &F, nullptr));
+    benchmark::ClobberMemory();
+  }
+  state.SetItemsProcessed(state.iterations() * static_cast<int64_t>(els.size()));
+}
+BENCHMARK(BM_AlgorithmicForceStepState256)->Unit(benchmark::kMillisecond);
+
+void BM_StepState(benchmark::State& state) {
+  const Setup s = make_setup();
+  const CR9Shell e(s.X0, s.p0, kMat);
+  CR9Shell::StepState sn;
+  for (auto _ : state) {
+    e.step_state(s.u, s.charts, &sn);
+    benchmark::ClobberMemory();
+  }
+}
+BENCHMARK(BM_StepState)->Unit(benchmark::kMicrosecond);
+
+// M(u) a + F_m(u, v) as a residual needs it (no mass matrix formed).
+void BM_InertiaForce(benchmark::State& state) {
+  const Setup s = make_setup();
+  const CR9Shell e(s.X0, s.p0, kMat);
+  CR9Shell::Vec45 f;
+  for (auto _ : state) {
+    e.inertia_force(s.u, s.u1, s.u1, s.charts, &f);
+    benchmark::ClobberMemory();
+  }
+}
+BENCHMARK(BM_InertiaForce)->Unit(benchmark::kMicrosecond);
 
 void BM_MassAndInertial(benchmark::State& state) {
   const Setup s = make_setup();

@@ -14,6 +14,7 @@
 #include "lib/profile.hpp"
 #include "lib/problem.hpp"
 
+#include "lib/openmp_wait_policy.hpp"
 #include <omp.h>
 
 #include <cstdio>

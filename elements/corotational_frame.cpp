@@ -70,7 +70,10 @@ CorotationalFrame::CorotationalFrame(const std::array<Eigen::Vector3d, 9>& x,
   R_.col(2) = ex.cross(ey);
   xO_ = 0.25 * (x[0] + x[1] + x[2] + x[3]);
   for (int i = 0; i < 9; ++i) rel_[i] = x[i] - xO_;
+}
 
+void CorotationalFrame::compute_derivatives() const {
+  const Eigen::Vector3d ex = R_.col(0), ey = R_.col(1);
   // §3.3 frame derivatives, per corner: G_a = [-I 0 I 0], G_b = [0 -I 0 I].
   Pa_ = unit_jacobian(a_);
   Pb_ = unit_jacobian(b_);
@@ -82,13 +85,17 @@ CorotationalFrame::CorotationalFrame(const std::array<Eigen::Vector3d, 9>& x,
   const Eigen::Matrix3d Sx = skew(ex), Sy = skew(ey);
   for (int k = 0; k < 4; ++k) E_[2][k] = -Sy * E_[0][k] + Sx * E_[1][k];
 
-  // Factored T = D + C P (§3.3 blocks).
   Eigen::Matrix<double, 2, 3> Exy;
   Exy.row(0) = ex.transpose();
   Exy.row(1) = ey.transpose();
+  for (int i = 0; i < 9; ++i) D_theta_[i] = Exy * A1_[i];  // ∂θ_i/∂q_i
+  have_derivatives_ = true;
+}
+
+void CorotationalFrame::compute_corner_columns() const {
+  // Factored T = D + C P (§3.3 blocks).
   C_.setZero();
   for (int i = 0; i < 9; ++i) {
-    D_theta_[i] = Exy * A1_[i];  // ∂θ_i/∂q_i
     for (int k = 0; k < 4; ++k) {
       // ∂t_i/∂d_k (corner part): -¼R^T + C_ik, C_ik row α = (x_i - x_O)^T E_α,k.
       Eigen::Matrix3d blk = -0.25 * R_.transpose();
@@ -98,6 +105,7 @@ CorotationalFrame::CorotationalFrame(const std::array<Eigen::Vector3d, 9>& x,
       for (int al = 0; al < 2; ++al) C_.block<1, 3>(5 * i + 3 + al, 3 * k) = p_[i].transpose() * E_[al][k];
     }
   }
+  have_corner_columns_ = true;
 }
 
 CorotationalFrame::Vec45 CorotationalFrame::local_variables(const std::array<Eigen::Vector3d, 9>& x_local0) const {
@@ -176,6 +184,7 @@ CorotationalFrame::Vec45 CorotationalFrame::local_variables(const std::array<Eig
 }
 
 CorotationalFrame::Vec45 CorotationalFrame::apply_transpose(const Vec45& fL) const {
+  corner_columns();
   Vec45 F;
   for (int i = 0; i < 9; ++i) {
     F.segment<3>(5 * i) = R_ * fL.segment<3>(5 * i);
@@ -187,6 +196,7 @@ CorotationalFrame::Vec45 CorotationalFrame::apply_transpose(const Vec45& fL) con
 }
 
 CorotationalFrame::Mat45 CorotationalFrame::matrix() const {
+  corner_columns();
   Mat45 T = Mat45::Zero();
   for (int i = 0; i < 9; ++i) {
     T.block<3, 3>(5 * i, 5 * i) = R_.transpose();
@@ -197,6 +207,7 @@ CorotationalFrame::Mat45 CorotationalFrame::matrix() const {
 }
 
 void CorotationalFrame::tangent(const Mat45& kL, const Vec45& fL, bool geometric, Mat45* K) const {
+  corner_columns();
   // T^T k_L T exploiting T = D + C P: ~7e4 multiplications instead of 1.8e5 for dense products.
   Mat45 kT;
   const Eigen::Matrix3d Rt = R_.transpose();
@@ -217,6 +228,7 @@ void CorotationalFrame::tangent(const Mat45& kL, const Vec45& fL, bool geometric
 }
 
 void CorotationalFrame::add_geometric_stiffness(const Vec45& fL, Mat45* K) const {
+  derivatives();
   // K_σ = Σ_j (f_L)_j ∂²(u_L)_j/∂u_G∂u_G, §3.4. Weight vectors:
   Eigen::Vector3d wx = Eigen::Vector3d::Zero(), wy = Eigen::Vector3d::Zero(), wz = Eigen::Vector3d::Zero();
   for (int i = 0; i < 9; ++i) {

@@ -6,6 +6,9 @@
 // θ_i = (e_x·p_i, e_y·p_i). T = ∂u_L/∂u_G (§3.3) is stored in factored form T = D + C P:
 // D is block diagonal (R^T on t_i/d_i, [e_x e_y]^T A1_i on θ_i/q_i) and C (45x12) holds the
 // dependence of every local variable on the 4 corner translations through the triad and x_O.
+// The constructor computes the triad and the origin only; the derivatives (the factors of T, ∂e_α/∂d_k)
+// are computed at the first call that needs them, so a frame used for local_variables() alone (the end
+// point of a strain-averaged step, docs/theory.md §6.3) costs no more than the triad.
 // Node-major DOF order, 5 per node: global [d_X,d_Y,d_Z,q_1,q_2], local [t_x,t_y,t_z,θ_x,θ_y].
 #pragma once
 
@@ -53,19 +56,37 @@ class CorotationalFrame {
   Mat45 matrix() const;
 
   // ∂e_α/∂d_k for α = x,y,z and corner k = 0..3 (§3.3).
-  const Eigen::Matrix3d& dE(int alpha, int corner) const { return E_[alpha][corner]; }
+  const Eigen::Matrix3d& dE(int alpha, int corner) const {
+    derivatives();
+    return E_[alpha][corner];
+  }
 
  private:
+  // §3.3 frame derivatives and the factors of T (lazy: once, at the first call that needs them).
+  void derivatives() const {
+    if (!have_derivatives_) compute_derivatives();
+  }
+  void compute_derivatives() const;
+  // The corner columns C of T (apply_transpose(), tangent(), matrix()).
+  void corner_columns() const {
+    derivatives();
+    if (!have_corner_columns_) compute_corner_columns();
+  }
+  void compute_corner_columns() const;
+
   std::array<Eigen::Vector3d, 9> rel_;  // x_i - x_O
   std::array<Eigen::Vector3d, 9> p_;
   std::array<Eigen::Matrix<double, 3, 2>, 9> A1_;
   std::array<Eigen::Matrix2d, 9> d2pl_;
   std::array<int, 9> l_;
   Eigen::Vector3d xO_, a_, b_, s_, c_;
-  Eigen::Matrix3d R_, Pa_, Pb_, Ps_, Pc_;
-  std::array<std::array<Eigen::Matrix3d, 4>, 3> E_;
-  std::array<Eigen::Matrix<double, 2, 2>, 9> D_theta_;  // [e_x e_y]^T A1_i
-  Eigen::Matrix<double, 45, 12> C_;                     // corner columns of T beyond D
+  Eigen::Matrix3d R_;
+  // Derivative data (compute_derivatives(); mutable: filled lazily by const methods, one frame per thread).
+  mutable bool have_derivatives_ = false, have_corner_columns_ = false;
+  mutable Eigen::Matrix3d Pa_, Pb_, Ps_, Pc_;
+  mutable std::array<std::array<Eigen::Matrix3d, 4>, 3> E_;
+  mutable std::array<Eigen::Matrix<double, 2, 2>, 9> D_theta_;  // [e_x e_y]^T A1_i
+  mutable Eigen::Matrix<double, 45, 12> C_;                     // corner columns of T beyond D
 };
 
 }  // namespace shelldyn

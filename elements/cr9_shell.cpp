@@ -218,6 +218,30 @@ CR9Shell::CR9Shell(const std::array<Eigen::Vector3d, 9>& X0, const std::array<Ei
     }
   }
   Kbs_ = 0.5 * (Kbs_ + Kbs_.transpose()).eval();
+  for (int g = 0; g < 9; ++g)
+    for (int c = 0; c < 3; ++c) {
+      const GaussPoint& gp = gp_[static_cast<size_t>(g)];
+      Lall_.row(3 * g + c) = gp.Lm.row(c);
+      for (int j = 0; j < 9; ++j)
+        for (int i = 0; i <= j; ++i) Hp_(i + j * (j + 1) / 2, 3 * g + c) = gp.Hm[static_cast<size_t>(c)](i, j);
+      dAall_(3 * g + c) = gp.dA;
+    }
+  for (int j = 0; j < 45; ++j)
+    for (int i = 0; i <= j; ++i) Kbsp_(i + j * (j + 1) / 2) = Kbs_(i, j);
+}
+
+CR9Shell::Vec45 CR9Shell::kbs_times(const Vec45& w) const {
+  // Symmetric packed product: column j of the upper triangle contributes K_ij w_j to y_i (i < j) and
+  // Σ_{i≤j} K_ij w_i to y_j.
+  Vec45 y;
+  const double* col = Kbsp_.data();
+  for (int j = 0; j < 45; ++j) {
+    const Eigen::Map<const Eigen::VectorXd> kj(col, j + 1);
+    y(j) = kj.dot(w.head(j + 1));
+    y.head(j) += w(j) * kj.head(j);
+    col += j + 1;
+  }
+  return y;
 }
 
 CorotationalFrame CR9Shell::local_increments(const Vec45& u, const Charts& charts, Vec45* w) const {
@@ -299,6 +323,41 @@ double CR9Shell::membrane(const Mat39& t1, const Mat39& t0, double c1, double c0
   return U;
 }
 
+double CR9Shell::membrane_force(const Mat39& t1, const Mat39& t0, double c1, double c0, double b1, double b0,
+                                const StepState& n0, Vec45* fL) const {
+  const Eigen::Matrix3d hD1 = mat_.thickness * D1_;
+  const Eigen::Map<const Eigen::Matrix<double, 27, 1>> v1(t1.data());
+  // ε_m,c at every Gauss point: L_m,c·t + ½ Σ_ij H_c(i,j) t_i·t_j = L_m,c·t + ½ H_c : (tᵀt)  (§4.5)
+  // Packed Gram matrix with the off-diagonal entries doubled: Σ_ij H_ij G_ij = Σ_k Hp_k g_k.
+  Eigen::Matrix<double, 45, 1> g;
+  for (int j = 0; j < 9; ++j) {
+    for (int i = 0; i < j; ++i) g(i + j * (j + 1) / 2) = 2.0 * t1.col(i).dot(t1.col(j));
+    g(j + j * (j + 1) / 2) = t1.col(j).squaredNorm();
+  }
+  Eigen::Matrix<double, 27, 1> e1 = Lall_ * v1;
+  e1.noalias() += 0.5 * (Hp_.transpose() * g);
+  // N* = h D1 (c1 ε1 + c0 ε0) per Gauss point (§6.3), weighted by dA: s = dA N*.
+  Eigen::Matrix<double, 27, 1> sN;
+  double U = 0.0;
+  for (int g = 0; g < 9; ++g) {
+    const Eigen::Vector3d eg = e1.segment<3>(3 * g);
+    const Eigen::Vector3d N = hD1 * (c1 * eg + c0 * n0.e[static_cast<size_t>(g)]);
+    const double dA = dAall_(3 * g);
+    U += 0.5 * dA * eg.dot(hD1 * eg);
+    sN.segment<3>(3 * g) = dA * N;
+  }
+  // Σ_gp dA B_mᵀ N with B_m,c = L_m,c + (t̄ H_c) rows, t̄ = b1 t1 + b0 t0: Lᵀ s + t̄ Σ_gp,c s_gp,c H_c.
+  Eigen::Matrix<double, 27, 1> fm = Lall_.transpose() * sN;
+  const Eigen::Matrix<double, 45, 1> hs = Hp_ * sN;
+  Mat9 Hs;
+  for (int j = 0; j < 9; ++j)
+    for (int i = 0; i <= j; ++i) Hs(i, j) = Hs(j, i) = hs(i + j * (j + 1) / 2);
+  const Mat39 tb = b1 * t1 + b0 * t0;
+  const Mat39 ft = tb.lazyProduct(Hs);
+  for (int i = 0; i < 9; ++i) fL->segment<3>(5 * i) += fm.segment<3>(3 * i) + ft.col(i);
+  return U;
+}
+
 namespace {
 Eigen::Matrix<double, 3, 9> translations(const Eigen::Matrix<double, 45, 1>& w) {
   Eigen::Matrix<double, 3, 9> t;
@@ -369,6 +428,7 @@ double CR9Shell::algorithmic_internal(const Vec45& u_n, const Vec45& u_np1, cons
 
 void CR9Shell::step_state(const Vec45& u_n, const Charts& charts, StepState* st) const {
   local_increments(u_n, charts, &st->w);
+  st->Kw = kbs_times(st->w);
   const Mat39 t0 = translations(st->w);
   const Eigen::Map<const Eigen::Matrix<double, 27, 1>> v0(t0.data());
   for (size_t g = 0; g < gp_.size(); ++g)
@@ -390,10 +450,18 @@ double CR9Shell::algorithmic_internal(const StepState& sn, const Vec45& u_n, con
   // As the plain overload, with w_n, ε_m(t_n) and t_n H_m from the step state.
   const Vec45& wn = sn.w;
   Vec45 w1;
-  local_increments(u_np1, charts, &w1);
+  local_increments(u_np1, charts, &w1);  // the frame at u_np1 serves w1 only (its derivatives are never formed)
   const Vec45 u_mid = (1.0 - alpha_f) * u_np1 + alpha_f * u_n;
   const CorotationalFrame fr = local_increments(u_mid, charts, nullptr);
   const double c1 = 1.0 - alpha_f + xi, c0 = alpha_f - xi;
+  if (!K) {  // residual: K_bs w_n from the step state, membrane force without its tangent
+    const Vec45 Kw1 = kbs_times(w1);
+    Vec45 fL = c1 * Kw1 + c0 * sn.Kw;
+    double U = 0.5 * w1.dot(Kw1);
+    U += membrane_force(translations(w1), translations(wn), c1, c0, 1.0 - alpha_f, alpha_f, sn, &fL);
+    if (F) *F = fr.apply_transpose(fL);
+    return U;
+  }
   Vec45 fL = Kbs_ * (c1 * w1 + c0 * wn);
   double U = 0.5 * w1.dot(Kbs_ * w1);
   const Mat39 t1 = translations(w1), t0 = translations(wn);
@@ -420,6 +488,25 @@ void CR9Shell::mass(const Vec45& u, const Charts& charts, Mat45* M) const {
       M->block<3, 3>(5 * i, 5 * j).diagonal().setConstant(rh * m_(i, j));
       M->block<2, 2>(5 * i + 3, 5 * j + 3).noalias() = (rh3 * m_(i, j)) * A1[i].transpose() * A1[j];
     }
+}
+
+void CR9Shell::inertia_force(const Vec45& u, const Vec45& v, const Vec45& a, const Charts& charts, Vec45* f) const {
+  const double rh = mat_.rho * mat_.thickness;
+  const double rh3 = rh * mat_.thickness * mat_.thickness / 12.0;
+  std::array<Eigen::Matrix<double, 3, 2>, 9> A1;
+  Eigen::Matrix<double, 3, 9> at, pdd;
+  for (int j = 0; j < 9; ++j) {
+    const Eigen::Vector2d q = u.segment<2>(5 * j + 3);
+    A1[j] = director_A1(q, charts[j]);
+    at.col(j) = a.segment<3>(5 * j);
+    pdd.col(j) = A1[j] * a.segment<2>(5 * j + 3) + director_A2(q, v.segment<2>(5 * j + 3), charts[j]);  // p̈_j
+  }
+  // Column i of X m is Σ_j m_ij X_j (m symmetric).
+  const Eigen::Matrix<double, 3, 9> mat = at.lazyProduct(m_), mpdd = pdd.lazyProduct(m_);
+  for (int i = 0; i < 9; ++i) {
+    f->segment<3>(5 * i) = rh * mat.col(i);
+    f->segment<2>(5 * i + 3) = rh3 * (A1[i].transpose() * mpdd.col(i));
+  }
 }
 
 void CR9Shell::inertial(const Vec45& u, const Vec45& v, const Charts& charts, Vec45* Fm) const {

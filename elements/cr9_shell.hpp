@@ -70,6 +70,7 @@ class CR9Shell {
   // step (the overload of algorithmic_internal below), with results identical to the plain overload.
   struct StepState {
     Vec45 w;
+    Vec45 Kw;                                                  // K_bs w_n (bending + shear force at t_n)
     std::array<Eigen::Vector3d, 9> e;                          // ε_m at t_n per Gauss point
     std::array<std::array<Eigen::Matrix<double, 3, 9>, 3>, 9> tH;  // t_n H_m,c per Gauss point and c
   };
@@ -78,6 +79,9 @@ class CR9Shell {
                               double alpha_f, double xi, Vec45* F, Mat45* K) const;
 
   void mass(const Vec45& u, const Charts& charts, Mat45* M) const;                        // §5.2
+  // M(u) a + F_m(u, v) without forming M (§5.2): ρh Σ_j m_ij a_j on the translations and
+  // (ρh³/12) A1_iᵀ Σ_j m_ij p̈_j, p̈_j = A1_j q̈_j + A2_j, on the director unknowns.
+  void inertia_force(const Vec45& u, const Vec45& v, const Vec45& a, const Charts& charts, Vec45* f) const;
   void inertial(const Vec45& u, const Vec45& v, const Charts& charts, Vec45* Fm) const;  // §5.2 F_m
   double kinetic(const Vec45& u, const Vec45& v, const Charts& charts) const;             // §5.1
   // §5.4 linear and angular momentum about the origin (J includes the director term). Either may be null.
@@ -116,6 +120,12 @@ class CR9Shell {
   // With n0 (the step state of t0), its strains and products are taken from there instead of recomputed.
   double membrane(const Mat39& t1, const Mat39& t0, double c1, double c0, double b1, double b0, Vec45* fL,
                   Mat45* kL, const StepState* n0 = nullptr) const;
+  // The membrane force alone (kL not wanted), same quantities as membrane() with the step state n0 of t0,
+  // evaluated through the Gram matrix G = t1ᵀt1 and the stacked Gauss-point data below: the strains are
+  // ε = L·t1 + ½ H:G, and Σ_gp dA B_mᵀ N = Lᵀs + t̄ (Σ s H) with s = dA N (a few matrix–vector products
+  // instead of 27 small 3×9·9×9 products). Equal to membrane() to round-off.
+  double membrane_force(const Mat39& t1, const Mat39& t0, double c1, double c0, double b1, double b0,
+                        const StepState& n0, Vec45* fL) const;
   // Local increments w = [t_i, Δθ_i] of u and the frame at u.
   CorotationalFrame local_increments(const Vec45& u, const Charts& charts, Vec45* w) const;
 
@@ -127,6 +137,13 @@ class CR9Shell {
   Options opt_;
   Eigen::Matrix3d D1_;                  // plane-stress matrix (§4.6)
   std::array<GaussPoint, 9> gp_;
+  // The data of membrane_force() and of K_bs w in the compact form a residual streams through (per element
+  // and residual ~24 kB instead of ~40 kB; a residual of a large mesh reads it from memory, not the cache):
+  Eigen::Matrix<double, 27, 27> Lall_;  // row 3g + c = gp_[g].Lm.row(c)
+  Eigen::Matrix<double, 45, 27> Hp_;    // column 3g + c = upper triangle of gp_[g].Hm[c], packed (k = i + j(j+1)/2)
+  Eigen::Matrix<double, 27, 1> dAall_;  // entry 3g + c = gp_[g].dA
+  Eigen::Matrix<double, 1035, 1> Kbsp_; // upper triangle of Kbs_, packed by columns (k = i + j(j+1)/2)
+  Vec45 kbs_times(const Vec45& w) const;  // Kbs_ w from Kbsp_
   Mat45 Kbs_;                           // constant bending + shear stiffness Σ dA (B_b^T M + B_s^T Q)
   std::array<Eigen::Matrix<double, 5, 45>, 9> Bbs_;  // [B_b; B_s] per Gauss point (output only)
   Eigen::Matrix<double, 9, 9> m_;

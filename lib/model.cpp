@@ -206,14 +206,10 @@ void Model::inertia_force(const Eigen::VectorXd& u, const Eigen::VectorXd& v, co
   std::fill(out, out + num_dofs(), 0.0);
   for_each_element(assembler_, [&](int e) {
     CR9Shell::Vec45 ue, ve, ae, fe;
-    CR9Shell::Mat45 me;
     gather(e, u, ue);
     gather(e, v, ve);
     gather(e, a, ae);
-    const auto ch = element_charts(e, charts);
-    elements_[static_cast<size_t>(e)].mass(ue, ch, &me);
-    elements_[static_cast<size_t>(e)].inertial(ue, ve, ch, &fe);
-    fe.noalias() += me * ae;
+    elements_[static_cast<size_t>(e)].inertia_force(ue, ve, ae, element_charts(e, charts), &fe);
     assembler_.add_vector(e, fe, out);
   });
   if (has_damping()) add_damping(v, out);

@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <functional>
 #include <limits>
 #include <sstream>
 #include <stdexcept>
@@ -80,6 +81,9 @@ struct NewtonSolver::Impl {
   std::vector<double> cache_u, cache_f, f_start, u_prev, du;
   bool cache_valid = false, first_eval_in_call = false;
   int residual_evals = 0, jacobian_evals = 0;
+  // skip_final_residual: the stopping tests run at the new iterate before F is evaluated there.
+  std::function<bool(const double* u_new)> early_test;
+  bool early_accepted = false;
 
   // Modified Newton bookkeeping (across solve() calls).
   bool have_jacobian = false, force_setup = false;
@@ -96,6 +100,20 @@ struct NewtonSolver::Impl {
       const double* up = N_VGetArrayPointer(uu);
       double* fp = N_VGetArrayPointer(ff);
       const size_t bytes = sizeof(double) * static_cast<size_t>(s->n);
+      if (s->early_test && !s->first_eval_in_call) {  // F at the call's new iterate (header: skip_final_residual)
+        bool accept = false;
+        try {
+          accept = s->early_test(up);
+        } catch (...) {
+          s->cb_error.capture("iteration hook");
+          return -1;
+        }
+        if (accept) {
+          s->early_accepted = true;
+          std::fill(fp, fp + s->n, 0.0);  // KINSOL stops on it; the wrapper returns u as accepted
+          return 0;
+        }
+      }
       if (s->cache_valid && std::memcmp(up, s->cache_u.data(), bytes) == 0) {
         std::memcpy(fp, s->cache_f.data(), bytes);
       } else {
@@ -237,6 +255,31 @@ NewtonSolver::Result NewtonSolver::solve(double* u, const Residual& residual, co
   bool energy_ok = false;  // energy test at the current iterate
   int k = 0;               // iterations done
 
+  // skip_final_residual (header): the energy test and the hook at the new iterate u_{k+1}, from Δu and
+  // F(u_k), with the arithmetic of the tests after the call (so they agree bitwise).
+  bool early_hook_called = false, early_hook_value = false;
+  s.early_accepted = false;
+  s.early_test = nullptr;
+  if (o.skip_final_residual && !o.line_search)
+    s.early_test = [&](const double* unew) {
+      if (k + 1 < o.min_iters) return false;
+      double E = 0;
+      for (Index i = 0; i < n; ++i) {
+        s.du[i] = unew[i] - s.u_prev[i];
+        E += s.du[i] * s.f_start[i];
+      }
+      E = std::abs(E);
+      const bool first = (k == 0);
+      const double e0 = first ? E : E0;
+      const double ratio = (e0 <= o.energy_floor) ? 0.0 : E / e0;
+      const bool eok = energy_test && ratio <= o.energy_tol && (!first || e0 <= o.energy_floor);
+      if (eok && (o.stop == StopTest::energy || o.stop == StopTest::fnorm_or_energy)) return true;
+      if (!hook) return false;
+      early_hook_called = true;
+      early_hook_value = hook(k + 1, unew, s.du.data(), s.f_start.data());
+      return early_hook_value;
+    };
+
   auto finish = [&](bool converged, StopReason why, int flag, std::string msg) {
     r.converged = converged;
     r.stop_reason = why;
@@ -245,10 +288,17 @@ NewtonSolver::Result NewtonSolver::solve(double* u, const Residual& residual, co
     r.residual_evals = s.residual_evals;
     r.jacobian_evals = s.jacobian_evals;
     r.factorizations = static_cast<int>(linear_solver().stats().factorizations - factorizations0);
-    if (s.cache_valid && std::memcmp(s.cache_u.data(), uu, sizeof(double) * n) == 0)
+    r.fnorm_at_u = true;
+    if (s.cache_valid && std::memcmp(s.cache_u.data(), uu, sizeof(double) * n) == 0) {
       r.fnorm = s.fnorm_inf(s.cache_f.data(), fs);
-    else
+    } else if (s.early_accepted && converged) {  // u accepted before F(u) was evaluated
+      r.fnorm = s.fnorm_inf(s.f_start.data(), fs);
+      r.fnorm_at_u = false;
+    } else {
       r.fnorm = std::numeric_limits<double>::quiet_NaN();  // F never evaluated at u (early failure)
+    }
+    s.early_test = nullptr;
+    s.early_accepted = false;
     r.message = std::move(msg);
     if (!converged) s.force_setup = true;  // do not reuse a Jacobian that just failed
     std::copy(uu, uu + n, u);
@@ -275,6 +325,7 @@ NewtonSolver::Result NewtonSolver::solve(double* u, const Residual& residual, co
     check_kin(KINSetNoInitSetup(s.kin, need_setup ? SUNFALSE : SUNTRUE), "KINSetNoInitSetup");
     std::copy(uu, uu + n, s.u_prev.begin());
     const int jac0 = s.jacobian_evals;
+    early_hook_called = false;
 
     // Before min_iters (or with the energy test alone) KINSOL must not stop on its own.
     bool forced = !fnorm_test || k < o.min_iters;
@@ -333,7 +384,9 @@ NewtonSolver::Result NewtonSolver::solve(double* u, const Residual& residual, co
     energy_ok = energy_test && r.energy_ratio <= o.energy_tol && (!first_call || E0 <= o.energy_floor);
 
     bool hook_accept = false;
-    if (hook) {
+    if (early_hook_called) {
+      hook_accept = early_hook_value;  // already asked at this iterate from the residual callback
+    } else if (hook) {
       try {
         hook_accept = hook(k, uu, s.du.data(), s.f_start.data());
       } catch (...) {
@@ -341,6 +394,11 @@ NewtonSolver::Result NewtonSolver::solve(double* u, const Residual& residual, co
         return finish(false, StopReason::failure, flag, s.cb_error.message());
       }
     }
+    if (s.early_accepted)  // F(u_k) was not evaluated (KINSOL saw F = 0): only these two tests may stop
+      return finish(true,
+                    energy_ok && (o.stop == StopTest::energy || o.stop == StopTest::fnorm_or_energy) ? StopReason::energy
+                                                                                                    : StopReason::hook,
+                    flag, {});
     if (k < o.min_iters) continue;
 
     const bool kinsol_ok = fnorm_test && (flag == KIN_SUCCESS || flag == KIN_STEP_LT_STPTOL);

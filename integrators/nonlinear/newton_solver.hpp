@@ -85,6 +85,13 @@ struct NewtonOptions {
   // tangent drifts away, and is observed rather than guessed by a fixed count. Corrections at round-off
   // (‖uscale·Δu‖₂ ≤ 1e3 ε max(1, ‖uscale·u‖₂)) never trigger a refresh: their ratio is noise.
   double refresh_contraction = 0.0;
+  // Skip the residual at an iterate that the energy test or the hook accepts (no line search only). Both
+  // tests read Δu_k and F(u_{k−1}), which are known before F(u_k); KINSOL evaluates F(u_k) inside the
+  // iteration for its own tests, so the wrapper runs the energy test and the hook from the residual
+  // callback at the new iterate first and, if they accept, hands KINSOL F = 0 instead of evaluating it
+  // (KINSOL's state is discarded; the next solve() starts afresh). The iterates are the same as without
+  // it; one residual per solve() fewer. Result.fnorm is then that of F(u_{k−1}) (fnorm_at_u = false).
+  bool skip_final_residual = false;
 };
 
 class NewtonSolver {
@@ -140,6 +147,7 @@ class NewtonSolver {
     int factorizations = 0;  // numeric factorizations done by the linear solver in this solve()
     double contraction = 0;  // last observed θ_k = ‖uscale·Δu_k‖₂/‖uscale·Δu_{k−1}‖₂ (0 before k = 2)
     double fnorm = 0;        // ‖fscale·F(u)‖∞ at the returned u (NaN if F failed there)
+    bool fnorm_at_u = true;  // false: skip_final_residual accepted u unevaluated; fnorm is F(u_{k−1})'s
     double energy_ratio = 1;  // last cc = E_{k-1}/E_0 (1 before the second iteration)
     int kinsol_flag = 0;     // flag of the last KINSol call (see header comment)
     StopReason stop_reason = StopReason::none;
