@@ -94,7 +94,7 @@ class Integrator {
   // Work dissipated by Rayleigh damping so far, Σ Δqᵀ C q̇ with the scheme's own velocity (docs/theory.md
   // §8.5); H = K + V − W_ext + W_damp is then the conserved total. 0 for integrators that do not track it.
   virtual double damping_work() const { return 0.0; }
-  // Work done on the system by prescribed displacement histories (docs/theory.md §2.5), Σ r_c Δu_c over the
+  // Work done on the system by prescribed displacement histories (docs/theory.md §8.6), Σ r_c Δu_c over the
   // prescribed DOFs with the scheme's own reaction r_c (the residual row of the DOF, at the scheme's
   // midpoint); H = K + V − W_ext − W_presc (+ W_damp) is then the conserved total.
   virtual double prescribed_work() const { return 0.0; }

@@ -487,7 +487,7 @@ std::vector<LoadSpec> parse_loads(const Parser& p, const YAML::Node& n) {
   return loads;
 }
 
-// prescribed_displacements (docs/manual.md §2.9).
+// prescribed_displacements (docs/manual.md §2.12).
 std::vector<PrescribedDisplacementSpec> parse_prescribed(const Parser& p, const YAML::Node& n) {
   p.require_sequence(n, "prescribed_displacements", "{set, dofs, value, [function]} entries");
   std::vector<PrescribedDisplacementSpec> out;

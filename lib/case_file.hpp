@@ -168,7 +168,7 @@ struct LoadSpec {
   std::string where;      // "FILE:LINE: loads[k]"
 };
 
-// Prescribed displacement history (docs/manual.md §2.9, docs/theory.md §2.5): each listed translation of every
+// Prescribed displacement history (docs/manual.md §2.12, docs/theory.md §8.6): each listed translation of every
 // node of `set` follows u(t) = value * function(t), measured from the reference configuration. Director DOFs
 // cannot follow a history (they can be held with boundary_conditions). The DOFs become constrained DOFs:
 // their reactions are reported, and the work the prescribed motion does is a term of the energy balance.

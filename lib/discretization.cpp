@@ -367,7 +367,7 @@ Discretization build_discretization(const CaseSpec& spec) {
                                       "); only components that are 0 on a symmetry plane can be fixed (use 'director' to clamp)");
         d.dofs.fix(node, f);
       }
-  // Prescribed displacement histories (docs/manual.md §2.9, docs/theory.md §2.5): constrained translations that
+  // Prescribed displacement histories (docs/manual.md §2.12, docs/theory.md §8.6): constrained translations that
   // follow value · f(t). A DOF is held by one condition only: fixed, or prescribed once.
   static const char* const kTranslation[] = {"ux", "uy", "uz"};
   std::map<Index, size_t> prescribed_by;  // DOF -> prescribed_displacements entry
@@ -473,6 +473,7 @@ Discretization build_discretization(const CaseSpec& spec) {
   // nodes' displacements and, with director columns, their unit directors. Fixed DOFs must keep their values.
   if (fs_extension(spec.initial_displacement) == ".csv") {
     const std::string& where = spec.initial_displacement_where;
+    d.initial_displacement_from_csv = true;
     d.initial_displacement_field = read_node_csv(spec.initial_displacement, n, where, "displacement field", "ux,uy,uz",
                                                  "px,py,pz", &d.initial_displacement_directors);
     const double tol = 1e-12 * std::max(d.mesh_size, 1.0);
@@ -518,7 +519,7 @@ Discretization build_discretization(const CaseSpec& spec) {
       continue;
     }
     const std::vector<int>& nodes = find_set(mesh, l.set, l.where + ".set");
-    if (l.type == LoadType::Force)  // a prescribed DOF takes its reaction, not a load (docs/manual.md §2.9)
+    if (l.type == LoadType::Force)  // a prescribed DOF takes its reaction, not a load (docs/manual.md §2.12)
       for (int node : nodes)
         for (int c = 0; c < 3; ++c) {
           const auto it = prescribed_by.find(DofMap::dof(node, c));

@@ -31,7 +31,7 @@ struct DiscreteLoad {
   TimeFunction function;
 };
 
-// A prescribed displacement history on one translation DOF (docs/theory.md §2.5): u = value · function(t).
+// A prescribed displacement history on one translation DOF (docs/theory.md §8.6): u = value · function(t).
 struct DiscretePrescribed {
   int node = 0;
   int component = 0;  // 0, 1, 2: ux, uy, uz
@@ -69,6 +69,7 @@ struct Discretization {
   std::vector<DiscretePrescribed> prescribed;
   // initial_displacement from a CSV file (docs/manual.md §2.6): node -> (u, p) for the nodes listed (p = the
   // unit director if the file has director columns, else unused); empty for a VTU (Problem::initial_state).
+  bool initial_displacement_from_csv = false;
   std::map<int, Eigen::Matrix<double, 6, 1>> initial_displacement_field;
   bool initial_displacement_directors = false;
   // all loads vanish and prescribed displacements stop moving for t >= loads_end (+inf if some never do; 0 if none)

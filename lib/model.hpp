@@ -39,7 +39,7 @@ struct NodalLoad {
 };
 
 // A prescribed displacement history on one constrained translation DOF: u_dof(t) = value · function(t)
-// (docs/theory.md §2.5).
+// (docs/theory.md §8.6).
 struct PrescribedMotion {
   Index dof = 0;
   double value = 0.0;
@@ -99,7 +99,7 @@ class Model final : public SemiDiscreteSystem {
   const std::vector<FollowerPressure>& follower_pressures() const { return follower_; }
   void set_unsymmetric_load_stiffness(bool full) { full_load_tangent_ = full; }
   void set_rayleigh_damping(double mass_coefficient, double stiffness_coefficient);
-  // Prescribed displacement histories (docs/theory.md §2.5). Every DOF must be a constrained translation of
+  // Prescribed displacement histories (docs/theory.md §8.6). Every DOF must be a constrained translation of
   // dofs() (throws std::invalid_argument otherwise) and appear once.
   void set_prescribed_motion(std::vector<PrescribedMotion> motion);
   const std::vector<PrescribedMotion>& prescribed_motion() const { return prescribed_; }

@@ -48,7 +48,7 @@ State state_from_displacement_field(const Model& model, const Discretization& di
   return s;
 }
 
-// Prescribed displacement histories (docs/theory.md §2.5) start at g(0) with the rate ġ(0⁺).
+// Prescribed displacement histories (docs/theory.md §8.6) start at g(0) with the rate ġ(0⁺).
 State with_prescribed_start(const Model& model, State s) {
   model.prescribed_displacement(s.t, s.u.data());
   model.prescribed_velocity(s.t, s.v.data());
@@ -66,8 +66,8 @@ State Problem::initial_state() const {
     bool has_time = false;
     State d;
     try {
-      d = disc.initial_displacement_field.empty() ? state_from_vtu(*model, spec.initial_displacement, &has_time)
-                                                  : state_from_displacement_field(*model, disc);
+      d = disc.initial_displacement_from_csv ? state_from_displacement_field(*model, disc)
+                                             : state_from_vtu(*model, spec.initial_displacement, &has_time);
     } catch (const std::exception& e) {
       throw std::runtime_error(spec.initial_displacement_where + ": " + e.what());
     }

@@ -60,7 +60,7 @@ class SemiDiscreteSystem {
   virtual bool has_damping() const { return false; }
   virtual void damping_force(const Eigen::VectorXd& /*v*/, double* /*out*/) const {}       // out = C v
   virtual void add_damping_matrix(double /*c*/, SparseMatrix& /*J*/) const {}              // J += c C
-  // Prescribed displacement histories (docs/theory.md §2.5): constrained translation DOFs whose value follows
+  // Prescribed displacement histories (docs/theory.md §8.6): constrained translation DOFs whose value follows
   // g(t) instead of staying 0. Integrators set them at t_{n+1} before solving the step (the constrained rows of
   // the residual are zero, so Newton keeps them there), take their rates from the scheme's own relations, and
   // accumulate the work of their reactions. Default: none.

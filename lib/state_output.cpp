@@ -98,7 +98,7 @@ State state_from_vtu(const Model& model, const std::string& path, bool* has_time
   }
   const std::vector<Index>& prescribed = model.prescribed_dofs();
   for (Index dof : dofs.constrained_dofs()) {
-    // A prescribed DOF (docs/theory.md §2.5) is displaced; the run replaces its value by g(0) anyway.
+    // A prescribed DOF (docs/theory.md §8.6) is displaced; the run replaces its value by g(0) anyway.
     if (std::binary_search(prescribed.begin(), prescribed.end(), dof)) continue;
     const int node = static_cast<int>(dof / kDofsPerNode), c = static_cast<int>(dof % kDofsPerNode);
     const size_t sn = static_cast<size_t>(node);

@@ -311,7 +311,7 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
     };
 
     Eigen::VectorXd u = un_;  // predictor u_{n+1} = u_n (theory §5)
-    sys.prescribed_displacement(t1, u.data());  // prescribed DOFs at g(t_{n+1}) (docs/theory.md §2.5)
+    sys.prescribed_displacement(t1, u.data());  // prescribed DOFs at g(t_{n+1}) (docs/theory.md §8.6)
     last_u_ = u;
     last_r_.setZero(n);
     const NewtonSolver::Result r = newton.solve(u.data(), residual, jacobian, nullptr, nullptr, hook);
@@ -352,7 +352,7 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
       dw += fd_.segment<3>(3 * i).dot(u.segment<3>(k) - un_.segment<3>(k));
     }
     work_ += dw;
-    // Reaction work of the prescribed translations (docs/theory.md §2.5): their rows of the translational
+    // Reaction work of the prescribed translations (docs/theory.md §8.6): their rows of the translational
     // balance, Σ (M_d Δv/Δt + F*_int − F_ext(t_mid))_c Δd_c, at the accepted iterate (fint_ is its force).
     for (Index dof : sys.prescribed_dofs()) {
       const Index i = dof / kDofsPerNode, c = dof % kDofsPerNode;

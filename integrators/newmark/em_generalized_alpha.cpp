@@ -367,7 +367,7 @@ class NewmarkFamily final : public Integrator {
       *why = r.message + " (cc = " + std::to_string(r.energy_ratio) + ", iterations = " + std::to_string(r.iterations) + ")";
       return false;
     }
-    if (sys.has_prescribed_motion()) {  // reaction work Σ r_c Δu_c of the prescribed DOFs (docs/theory.md §2.5)
+    if (sys.has_prescribed_motion()) {  // reaction work Σ r_c Δu_c of the prescribed DOFs (docs/theory.md §8.6)
       keep_constrained = true;
       rc_.resize(n);
       residual(u.data(), rc_.data());

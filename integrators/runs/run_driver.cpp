@@ -309,7 +309,7 @@ RunSummary run_dynamic(Problem& problem, const RunOptions& o) {
     std::vector<std::string> names;
     for (const auto& m : monitors) names.push_back(m.name);
     // damping_work: energy dissipated by Rayleigh damping (docs/theory.md §8.5), only for damped models.
-    // prescribed_work: work of the prescribed displacement histories (docs/theory.md §2.5), only when there are some.
+    // prescribed_work: work of the prescribed displacement histories (docs/theory.md §8.6), only when there are some.
     std::vector<std::string> extra;
     if (model.has_damping()) extra.push_back("damping_work");
     if (model.has_prescribed_motion()) extra.push_back("prescribed_work");

@@ -119,7 +119,7 @@ struct RunSummary {
   // Rayleigh-damped model (docs/theory.md §8.5): H then includes + W_damp; damping_work = W_damp at the end.
   bool damped = false;
   double damping_work = 0.0;
-  // Prescribed displacement histories (docs/theory.md §2.5): H then includes − W_presc; prescribed_work = W_presc
+  // Prescribed displacement histories (docs/theory.md §8.6): H then includes − W_presc; prescribed_work = W_presc
   // at the end.
   bool prescribed = false;
   double prescribed_work = 0.0;
