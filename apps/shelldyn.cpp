@@ -126,6 +126,17 @@ void print_summary(std::ostream& out, const CaseSpec& c, const Discretization& d
     row("") << l.set << ": " << load_type_name(l.type) << " " << l.amplitude << " * " << vec_text(l.direction)
             << " * " << l.function.describe() << ", " << load_distribution_name(l.distribution) << "\n";
   }
+  if (!c.prescribed_displacements.empty()) {  // docs/manual.md §2.12
+    row("prescribed disp.") << c.prescribed_displacements.size() << " entries -> " << d.prescribed.size() << " DOFs";
+    double end = 0.0;
+    for (const auto& pd : d.prescribed) end = std::max(end, pd.function.end_of_variation());
+    out << (std::isinf(end) ? std::string("; some never stop moving") : "; all still for t >= " + std::to_string(end)) << "\n";
+    for (const auto& pd : c.prescribed_displacements) {
+      std::string dofs;
+      for (int k : pd.components) dofs += (dofs.empty() ? "" : " ") + std::string(k == 0 ? "ux" : k == 1 ? "uy" : "uz");
+      row("") << pd.set << ": " << dofs << " = " << pd.value << " * " << pd.function.describe() << "\n";
+    }
+  }
   std::string settings;
   for (const auto& [k, v] : c.integrator.settings) settings += (settings.empty() ? "" : ", ") + k + " = " + v;
   row("integrator") << c.integrator.name << (settings.empty() ? "" : " (" + settings + ")") << "\n";
@@ -170,7 +181,7 @@ int run_check(const CheckOptions& o) {
   validate_case_integrator(spec);  // exactly as `run` will (FILE:LINE: integrator.KEY: ...)
   const Discretization d = build_discretization(spec);
   VtuFields fields = initial_fields(d);
-  if (!spec.initial_displacement.empty()) {  // validate it as `run` will, and show the displaced state
+  if (!spec.initial_displacement.empty() || !d.prescribed.empty()) {  // validate as `run` will, show the displaced state
     const Problem pb = make_problem(spec);
     const State s = pb.initial_state();
     const VtuFields displaced = state_fields(*pb.model, s);

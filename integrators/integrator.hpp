@@ -94,6 +94,13 @@ class Integrator {
   // Work dissipated by Rayleigh damping so far, Σ Δqᵀ C q̇ with the scheme's own velocity (docs/theory.md
   // §8.5); H = K + V − W_ext + W_damp is then the conserved total. 0 for integrators that do not track it.
   virtual double damping_work() const { return 0.0; }
+  // Work done on the system by prescribed displacement histories (docs/theory.md §8.6), Σ r_c Δu_c over the
+  // prescribed DOFs with the scheme's own reaction r_c (the residual row of the DOF, at the scheme's
+  // midpoint); H = K + V − W_ext − W_presc (+ W_damp) is then the conserved total.
+  virtual double prescribed_work() const { return 0.0; }
+  // Whether the integrator follows prescribed displacement histories. Cases that have them are refused by
+  // integrators that do not (integrators/runs/case_integrator.cpp), never run with the DOFs held at 0.
+  virtual bool supports_prescribed_motion() const { return false; }
 
   // Checkpoint/restart. save() is called between advance() calls (or after an advance() that stopped
   // early on a stop request), restore() right after initialize() with the saved State already in

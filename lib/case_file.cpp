@@ -487,6 +487,43 @@ std::vector<LoadSpec> parse_loads(const Parser& p, const YAML::Node& n) {
   return loads;
 }
 
+// prescribed_displacements (docs/manual.md §2.12).
+std::vector<PrescribedDisplacementSpec> parse_prescribed(const Parser& p, const YAML::Node& n) {
+  p.require_sequence(n, "prescribed_displacements", "{set, dofs, value, [function]} entries");
+  std::vector<PrescribedDisplacementSpec> out;
+  for (size_t k = 0; k < n.size(); ++k) {
+    const std::string path = "prescribed_displacements[" + std::to_string(k) + "]";
+    const YAML::Node e = n[k];
+    p.check_keys(e, path, {"set", "dofs", "value", "function"}, {"set", "dofs", "value"});
+    PrescribedDisplacementSpec d;
+    d.where = p.where(e, path);
+    d.set = p.name(e["set"], path + ".set");
+    const YAML::Node dofs = e["dofs"];
+    p.require_sequence(dofs, path + ".dofs", "DOF names (ux, uy, uz)");
+    if (dofs.size() == 0) p.fail(dofs, path + ".dofs", "empty list (name at least one of ux, uy, uz)");
+    for (size_t j = 0; j < dofs.size(); ++j) {
+      const std::string dp = path + ".dofs[" + std::to_string(j) + "]";
+      const std::string name = p.string(dofs[j], dp);
+      int c = -1;
+      if (name == "ux") c = 0;
+      else if (name == "uy") c = 1;
+      else if (name == "uz") c = 2;
+      else if (name == "px" || name == "py" || name == "pz" || name == "director")
+        p.fail(dofs[j], dp, "director DOF '" + name + "' cannot follow a history: only ux, uy, uz can (hold the director "
+                            "with boundary_conditions: [{set: " + d.set + ", fix: [director]}])");
+      else
+        p.fail(dofs[j], dp, "unknown DOF name '" + name + "' (expected one of: ux, uy, uz)");
+      if (std::find(d.components.begin(), d.components.end(), c) != d.components.end())
+        p.fail(dofs[j], dp, "'" + name + "' is listed twice (keep only one)");
+      d.components.push_back(c);
+    }
+    d.value = p.number(e["value"], path + ".value");
+    if (e["function"]) d.function = parse_function(p, e["function"], path + ".function");
+    out.push_back(std::move(d));
+  }
+  return out;
+}
+
 DampingSpec parse_damping(const Parser& p, const YAML::Node& n) {
   p.check_keys(n, "damping", {"mass", "stiffness"}, {});
   DampingSpec d;
@@ -589,7 +626,7 @@ CaseSpec parse_document(const Parser& p, const YAML::Node& root, const std::stri
   if (!root.IsDefined() || root.IsNull()) p.fail(root, "", "the case file is empty (see apps/cases/ for examples)");
   p.check_keys(root, "",
                {"name", "description", "mesh", "material", "sets", "boundary_conditions", "initial_velocity", "initial_displacement", "loads",
-                "damping", "integrator", "time", "output", "monitors"},
+                "prescribed_displacements", "damping", "integrator", "time", "output", "monitors"},
                {"mesh", "material", "integrator", "time"});
   CaseSpec c;
   c.source = p.source();
@@ -622,14 +659,15 @@ CaseSpec parse_document(const Parser& p, const YAML::Node& root, const std::stri
   }
   if (root["initial_displacement"]) {  // docs/manual.md §2.6
     const YAML::Node id = root["initial_displacement"];
-    if (!id.IsMap()) p.fail(id, "initial_displacement", "expected a mapping {field: FILE.vtu}, got a " + node_kind(id));
+    if (!id.IsMap()) p.fail(id, "initial_displacement", "expected a mapping {field: FILE.vtu | FILE.csv}, got a " + node_kind(id));
     p.check_keys(id, "initial_displacement", {"field"}, {"field"});
     fs::path file(p.string(id["field"], "initial_displacement.field"));
     std::string ext = file.extension().string();
     for (char& ch : ext) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
-    if (ext != ".vtu")
+    if (ext != ".vtu" && ext != ".csv")
       p.fail(id["field"], "initial_displacement.field",
-             "'" + file.string() + "' is not a .vtu file: give a fields/step_NNNNNN.vtu written by shelldyn");
+             "'" + file.string() + "' is neither a .vtu nor a .csv file: give a fields/step_NNNNNN.vtu written by shelldyn "
+             "or a CSV node,ux,uy,uz[,px,py,pz]");
     if (file.is_relative()) file = fs::path(base_dir) / file;
     c.initial_displacement = file.lexically_normal().string();
     c.initial_displacement_where = p.where(id, "initial_displacement.field");
@@ -641,6 +679,7 @@ CaseSpec parse_document(const Parser& p, const YAML::Node& root, const std::stri
              "the initial velocity must then be a field (e.g. the same VTU), not a rigid motion or mode");
   }
   if (root["loads"]) c.loads = parse_loads(p, root["loads"]);
+  if (root["prescribed_displacements"]) c.prescribed_displacements = parse_prescribed(p, root["prescribed_displacements"]);
   if (root["damping"]) c.damping = parse_damping(p, root["damping"]);
   c.integrator = parse_integrator(p, root["integrator"]);
   c.time = parse_time(p, root["time"]);

@@ -28,11 +28,12 @@
 //   initial_velocity: {[set = all], [translation], [angular], [about: centroid | [x,y,z]] | [field: v.csv | fields/step_N.vtu]
 //                      | [mode: mode_shapes.csv, index: k, amplitude: A]}
 //                     or a list of such entries (later ones override earlier ones)         optional
-//   initial_displacement: {field: fields/step_N.vtu}  (displacement and director of a run)  optional
+//   initial_displacement: {field: fields/step_N.vtu | u.csv}  (displacement and director of a run)  optional
 //   loads: [{set, type: force|moment, direction, amplitude, [distribution: per_node|edge_total|per_length],
 //            [function: {type: constant|ramp|hat|triangle|table, ...}]}
 //          | {[set = all], type: pressure|follower_pressure, amplitude, [function]}
 //          | {[set = all], type: body_force|gravity, direction, amplitude, [function]}, ...]   optional
+//   prescribed_displacements: [{set, dofs: [ux|uy|uz, ...], value, [function]}, ...]  optional
 //   damping: {[mass = 0], [stiffness = 0]}                                             optional
 // The full reference with types, defaults and units is docs/manual.md.
 //   integrator: {name, ...settings}    settings kept as ordered (key, scalar text) pairs
@@ -167,6 +168,18 @@ struct LoadSpec {
   std::string where;      // "FILE:LINE: loads[k]"
 };
 
+// Prescribed displacement history (docs/manual.md §2.12, docs/theory.md §8.6): each listed translation of every
+// node of `set` follows u(t) = value * function(t), measured from the reference configuration. Director DOFs
+// cannot follow a history (they can be held with boundary_conditions). The DOFs become constrained DOFs:
+// their reactions are reported, and the work the prescribed motion does is a term of the energy balance.
+struct PrescribedDisplacementSpec {
+  std::string set;
+  std::vector<int> components;  // 0, 1, 2 for ux, uy, uz (no repeats)
+  double value = 0.0;           // length
+  TimeFunction function;        // default constant
+  std::string where;            // "FILE:LINE: prescribed_displacements[k]"
+};
+
 // Rayleigh damping C = mass * M_0 + stiffness * K_0 (docs/theory.md §8.5); both 0: none.
 struct DampingSpec {
   double mass = 0.0;       // a_M [1/time]
@@ -227,11 +240,12 @@ struct CaseSpec {
   std::vector<BoundaryConditionSpec> boundary_conditions;
   InitialVelocitySpec initial_velocity;                 // the mapping form, or the first entry of the list form
   std::vector<InitialVelocitySpec> initial_velocity_more;  // further entries of the list form
-  // initial_displacement: {field: FILE.vtu}: the displacements and directors of a VTU written by shelldyn
-  // (docs/manual.md §2.6); empty: the reference configuration.
+  // initial_displacement: {field: FILE.vtu | FILE.csv}: the displacements and directors of a VTU written by
+  // shelldyn, or a CSV "node,ux,uy,uz[,px,py,pz]" (docs/manual.md §2.6); empty: the reference configuration.
   std::string initial_displacement;
   std::string initial_displacement_where;
   std::vector<LoadSpec> loads;
+  std::vector<PrescribedDisplacementSpec> prescribed_displacements;
   DampingSpec damping;
   IntegratorSpec integrator;
   TimeSpec time;

@@ -59,6 +59,38 @@ const std::vector<int>& find_set(const Mesh& mesh, const std::string& name, cons
   return it->second;
 }
 
+// A CSV of nodal 3- or 6-vectors with the header "node,<cols3>[,<cols6>]", 0-based node indices, any subset of
+// the nodes (docs/manual.md §2.6): the velocity fields of initial_velocity (vx,vy,vz[,pdx,pdy,pdz]) and the
+// displacement fields of initial_displacement (ux,uy,uz[,px,py,pz]). `what` names the file in messages;
+// *with6 (if given) tells whether the file has the last three columns (they are 0 otherwise).
+std::map<int, Eigen::Matrix<double, 6, 1>> read_node_csv(const std::string& path, int num_nodes, const std::string& where,
+                                                         const std::string& what, const std::string& cols3,
+                                                         const std::string& cols6, bool* with6) {
+  std::ifstream in(path);
+  if (!in) fail(where, "cannot open the " + what + " '" + path + "' (check the path; relative to the case file)");
+  std::string line;
+  std::getline(in, line);
+  const bool with_director = std::count(line.begin(), line.end(), ',') >= 6;
+  if (line.rfind("node", 0) != 0)
+    fail(where, path + ":1: expected the header 'node," + cols3 + "' or 'node," + cols3 + "," + cols6 + "'");
+  if (with6) *with6 = with_director;
+  std::map<int, Eigen::Matrix<double, 6, 1>> out;
+  for (int lineno = 2; std::getline(in, line); ++lineno) {
+    if (line.empty()) continue;
+    std::replace(line.begin(), line.end(), ',', ' ');
+    std::istringstream is(line);
+    long long node = -1;
+    Eigen::Matrix<double, 6, 1> v = Eigen::Matrix<double, 6, 1>::Zero();
+    is >> node >> v[0] >> v[1] >> v[2];
+    if (with_director) is >> v[3] >> v[4] >> v[5];
+    if (!is || node < 0 || node >= num_nodes || !v.allFinite())
+      fail(where, path + ":" + std::to_string(lineno) + ": expected a node index in [0, " + std::to_string(num_nodes) +
+                      ") and " + (with_director ? "6" : "3") + " finite numbers");
+    out[static_cast<int>(node)] = v;
+  }
+  return out;
+}
+
 // A velocity field (docs/manual.md §2.6): node -> (v, ṗ). Either a VTU written by shelldyn (point data
 // `velocity` and, if present, `director_rate`; every node; its reference positions must be the mesh's) or a CSV
 // "node,vx,vy,vz[,pdx,pdy,pdz]" (header line, 0-based node indices, any subset of the nodes).
@@ -86,28 +118,7 @@ std::map<int, Eigen::Matrix<double, 6, 1>> read_velocity_field(const std::string
   }
   if (ext != ".csv")
     fail(where, "the velocity field '" + path + "' must be a .vtu or a .csv file (docs/manual.md §2.6)");
-  std::ifstream in(path);
-  if (!in) fail(where, "cannot open the velocity field '" + path + "' (check the path; relative to the case file)");
-  std::string line;
-  std::getline(in, line);
-  const bool with_director = std::count(line.begin(), line.end(), ',') >= 6;
-  if (line.rfind("node", 0) != 0)
-    fail(where, path + ":1: expected the header 'node,vx,vy,vz' or 'node,vx,vy,vz,pdx,pdy,pdz'");
-  std::map<int, Eigen::Matrix<double, 6, 1>> out;
-  for (int lineno = 2; std::getline(in, line); ++lineno) {
-    if (line.empty()) continue;
-    std::replace(line.begin(), line.end(), ',', ' ');
-    std::istringstream is(line);
-    long long node = -1;
-    Eigen::Matrix<double, 6, 1> v = Eigen::Matrix<double, 6, 1>::Zero();
-    is >> node >> v[0] >> v[1] >> v[2];
-    if (with_director) is >> v[3] >> v[4] >> v[5];
-    if (!is || node < 0 || node >= num_nodes || !v.allFinite())
-      fail(where, path + ":" + std::to_string(lineno) + ": expected a node index in [0, " + std::to_string(num_nodes) +
-                      ") and " + (with_director ? "6" : "3") + " finite numbers");
-    out[static_cast<int>(node)] = v;
-  }
-  return out;
+  return read_node_csv(path, num_nodes, where, "velocity field", "vx,vy,vz", "pdx,pdy,pdz", nullptr);
 }
 
 // Mode `index` (1-based) of a mode-shape file written by `shelldyn modes` (mode_shapes.csv:
@@ -356,11 +367,43 @@ Discretization build_discretization(const CaseSpec& spec) {
                                       "); only components that are 0 on a symmetry plane can be fixed (use 'director' to clamp)");
         d.dofs.fix(node, f);
       }
+  // Prescribed displacement histories (docs/manual.md §2.12, docs/theory.md §8.6): constrained translations that
+  // follow value · f(t). A DOF is held by one condition only: fixed, or prescribed once.
+  static const char* const kTranslation[] = {"ux", "uy", "uz"};
+  std::map<Index, size_t> prescribed_by;  // DOF -> prescribed_displacements entry
+  for (size_t k = 0; k < spec.prescribed_displacements.size(); ++k) {
+    const PrescribedDisplacementSpec& ps = spec.prescribed_displacements[k];
+    for (int node : find_set(mesh, ps.set, ps.where + ".set"))
+      for (int c : ps.components) {
+        const Index dof = DofMap::dof(node, c);
+        for (size_t b = 0; b < spec.boundary_conditions.size(); ++b) {
+          const BoundaryConditionSpec& bc = spec.boundary_conditions[b];
+          const Fix f = c == 0 ? Fix::Ux : c == 1 ? Fix::Uy : Fix::Uz;
+          if (std::find(bc.fix.begin(), bc.fix.end(), f) == bc.fix.end()) continue;
+          const std::vector<int>& held = find_set(mesh, bc.set, bc.where + ".set");
+          if (std::find(held.begin(), held.end(), node) != held.end())
+            fail(ps.where + ".dofs", std::string(kTranslation[c]) + " of node " + std::to_string(node) +
+                                         " is prescribed here and fixed by boundary_conditions[" + std::to_string(b) +
+                                         "] (set '" + bc.set + "'); a DOF is either fixed or prescribed: remove it from one of them");
+        }
+        const auto [it, fresh] = prescribed_by.emplace(dof, k);
+        if (!fresh)
+          fail(ps.where + ".dofs", std::string(kTranslation[c]) + " of node " + std::to_string(node) +
+                                       " is already prescribed by prescribed_displacements[" + std::to_string(it->second) +
+                                       "]; prescribe each DOF once");
+        d.dofs.fix(node, c == 0 ? Fix::Ux : c == 1 ? Fix::Uy : Fix::Uz);
+        d.prescribed.push_back({node, c, ps.value, ps.function});
+      }
+  }
   try {
     d.dofs.resolve(d.charts);
   } catch (const std::exception& e) {
     fail(spec.boundary_conditions.empty() ? spec.source : spec.boundary_conditions.front().where, e.what());
   }
+  // ġ(0⁺) of each prescribed DOF: its initial velocity.
+  std::map<Index, double> prescribed_rate;
+  for (const DiscretePrescribed& pd : d.prescribed)
+    prescribed_rate[DofMap::dof(pd.node, pd.component)] = pd.value * pd.function.rate(0.0);
 
   // Initial velocity (docs/manual.md §2.6): rigid-body fields v = v0 + ω × (X − about), ṗ = ω × p
   // (docs/benchmarks.md §6) on sets, or nodal values from a CSV file; later entries override earlier ones.
@@ -406,15 +449,53 @@ Discretization build_discretization(const CaseSpec& spec) {
         d.initial_director_rate[si] = iv.angular.cross(d.normals[si]);
       }
     }
-    // A prescribed DOF cannot start moving: refuse instead of silently zeroing the user's field.
+    // A fixed DOF cannot start moving, and a prescribed one starts with its history's rate: refuse a different
+    // value instead of silently overwriting the user's field.
     for (Index dof : d.dofs.constrained_dofs()) {
       const double value = d.initial_velocity[static_cast<Eigen::Index>(dof)];
-      if (std::abs(value) > 1e-12 * scale) {
+      const auto pr = prescribed_rate.find(dof);
+      const double expected = pr == prescribed_rate.end() ? 0.0 : pr->second;
+      if (std::abs(value) > 1e-12 * scale && std::abs(value - expected) > 1e-12 * std::max(scale, std::abs(expected))) {
         std::ostringstream os;
-        os << "the initial velocity is " << value << " at DOF " << dof % kDofsPerNode << " of node "
-           << dof / kDofsPerNode << ", which a boundary condition fixes (remove the condition or change the velocity)";
+        os << "the initial velocity is " << value << " at DOF " << dof % kDofsPerNode << " of node " << dof / kDofsPerNode;
+        if (pr == prescribed_rate.end())
+          os << ", which a boundary condition fixes (remove the condition or change the velocity)";
+        else
+          os << ", whose prescribed displacement starts with the rate " << expected
+             << " (a prescribed DOF takes its history's rate: leave it out of the initial velocity)";
         fail(iv.where, os.str());
       }
+    }
+  }
+  for (const auto& [dof, rate] : prescribed_rate) d.initial_velocity[static_cast<Eigen::Index>(dof)] = rate;
+
+  // initial_displacement from a CSV (docs/manual.md §2.6; a VTU is read by Problem::initial_state): the listed
+  // nodes' displacements and, with director columns, their unit directors. Fixed DOFs must keep their values.
+  if (fs_extension(spec.initial_displacement) == ".csv") {
+    const std::string& where = spec.initial_displacement_where;
+    d.initial_displacement_from_csv = true;
+    d.initial_displacement_field = read_node_csv(spec.initial_displacement, n, where, "displacement field", "ux,uy,uz",
+                                                 "px,py,pz", &d.initial_displacement_directors);
+    const double tol = 1e-12 * std::max(d.mesh_size, 1.0);
+    for (auto& [node, x] : d.initial_displacement_field) {
+      const size_t sn = static_cast<size_t>(node);
+      for (int c = 0; c < 3; ++c) {
+        const Index dof = DofMap::dof(node, c);
+        if (d.dofs.is_constrained(dof) && !prescribed_rate.count(dof) && std::abs(x[c]) > tol)
+          fail(where, spec.initial_displacement + ": node " + std::to_string(node) + " has " + kTranslation[c] + " = " +
+                          std::to_string(x[c]) + ", which a boundary condition fixes at 0 (remove the condition or the value)");
+      }
+      if (!d.initial_displacement_directors) continue;
+      const Vec3 p(x[3], x[4], x[5]);
+      if (std::abs(p.norm() - 1.0) > 1e-6)
+        fail(where, spec.initial_displacement + ": the director (px, py, pz) of node " + std::to_string(node) +
+                        " has length " + std::to_string(p.norm()) + ", not 1 (give unit directors)");
+      x.tail<3>() = p.normalized();
+      const bool held = d.dofs.is_constrained(DofMap::dof(node, 3)) || d.dofs.is_constrained(DofMap::dof(node, 4));
+      if (held && (x.tail<3>() - d.normals[sn]).norm() > 1e-9)
+        fail(where, spec.initial_displacement + ": node " + std::to_string(node) +
+                        " has a director other than its reference one, which a boundary condition holds (remove the "
+                        "condition or give p = " + fmt(d.normals[sn]) + ")");
     }
   }
 
@@ -438,6 +519,16 @@ Discretization build_discretization(const CaseSpec& spec) {
       continue;
     }
     const std::vector<int>& nodes = find_set(mesh, l.set, l.where + ".set");
+    if (l.type == LoadType::Force)  // a prescribed DOF takes its reaction, not a load (docs/manual.md §2.12)
+      for (int node : nodes)
+        for (int c = 0; c < 3; ++c) {
+          const auto it = prescribed_by.find(DofMap::dof(node, c));
+          if (it != prescribed_by.end() && vec[c] != 0.0)
+            fail(l.where + ".set", "this force acts along " + std::string(kTranslation[c]) + " on node " + std::to_string(node) +
+                                       ", which prescribed_displacements[" + std::to_string(it->second) +
+                                       "] prescribes (a prescribed DOF carries a reaction instead: remove the node from the "
+                                       "load's set or the prescription)");
+        }
     if (l.distribution == LoadDistribution::PerLength) {
       const std::map<int, Vec3> f = edge_line_forces(mesh, nodes, vec);
       if (f.empty())
@@ -451,6 +542,8 @@ Discretization build_discretization(const CaseSpec& spec) {
         d.loads.push_back({node, l.type, w * vec, l.function});
     }
   }
+
+  for (const DiscretePrescribed& pd : d.prescribed) d.loads_end = std::max(d.loads_end, pd.function.end_of_variation());
 
   // Monitors.
   for (const MonitorSpec& m : spec.monitors) {

@@ -16,6 +16,7 @@
 #include "lib/time_function.hpp"
 
 #include <Eigen/Core>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -27,6 +28,14 @@ struct DiscreteLoad {
   int node = 0;
   LoadType type = LoadType::Force;
   Vec3 vector = Vec3::Zero();
+  TimeFunction function;
+};
+
+// A prescribed displacement history on one translation DOF (docs/theory.md §8.6): u = value · function(t).
+struct DiscretePrescribed {
+  int node = 0;
+  int component = 0;  // 0, 1, 2: ux, uy, uz
+  double value = 0.0;
   TimeFunction function;
 };
 
@@ -55,7 +64,16 @@ struct Discretization {
   std::vector<Vec3> initial_director_rate;
   std::vector<DiscreteLoad> loads;    // nodal forces/moments, incl. dead pressure, body force, edge loads
   std::vector<FollowerPressure> follower_pressures;  // evaluated on the current geometry by the Model
-  double loads_end = 0.0;             // all loads vanish for t >= loads_end (+inf if some never do; 0 if none)
+  // Prescribed displacement histories, one per DOF (also recorded as constraints in `dofs`); the initial
+  // velocity of those DOFs is their history's rate at t = 0.
+  std::vector<DiscretePrescribed> prescribed;
+  // initial_displacement from a CSV file (docs/manual.md §2.6): node -> (u, p) for the nodes listed (p = the
+  // unit director if the file has director columns, else unused); empty for a VTU (Problem::initial_state).
+  bool initial_displacement_from_csv = false;
+  std::map<int, Eigen::Matrix<double, 6, 1>> initial_displacement_field;
+  bool initial_displacement_directors = false;
+  // all loads vanish and prescribed displacements stop moving for t >= loads_end (+inf if some never do; 0 if none)
+  double loads_end = 0.0;
   std::vector<Monitor> monitors;
   double surface_area = 0.0;
   double total_mass = 0.0;            // rho * thickness * surface_area

@@ -307,7 +307,31 @@ double Model::loads_end() const {
   double end = 0.0;
   for (const auto& load : loads_) end = std::max(end, load.function.end_of_support());
   for (const auto& load : follower_) end = std::max(end, load.function.end_of_support());
+  for (const auto& m : prescribed_) end = std::max(end, m.function.end_of_variation());
   return end;
+}
+
+void Model::set_prescribed_motion(std::vector<PrescribedMotion> motion) {
+  std::sort(motion.begin(), motion.end(), [](const PrescribedMotion& a, const PrescribedMotion& b) { return a.dof < b.dof; });
+  for (size_t k = 0; k < motion.size(); ++k) {
+    const Index dof = motion[k].dof;
+    if (dof < 0 || dof >= num_dofs() || dof % kDofsPerNode >= 3 || !dofs_.is_constrained(dof))
+      throw std::invalid_argument("prescribed motion on DOF " + std::to_string(dof) +
+                                  ", which is not a constrained translation of the model");
+    if (k > 0 && motion[k - 1].dof == dof)
+      throw std::invalid_argument("prescribed motion given twice for DOF " + std::to_string(dof));
+  }
+  prescribed_ = std::move(motion);
+  prescribed_dofs_.clear();
+  for (const auto& m : prescribed_) prescribed_dofs_.push_back(m.dof);
+}
+
+void Model::prescribed_displacement(double t, double* u) const {
+  for (const auto& m : prescribed_) u[m.dof] = m.value * m.function(t);
+}
+
+void Model::prescribed_velocity(double t, double* v) const {
+  for (const auto& m : prescribed_) v[m.dof] = m.value * m.function.rate(t);
 }
 
 void Model::set_rayleigh_damping(double mass_coefficient, double stiffness_coefficient) {

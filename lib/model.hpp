@@ -38,6 +38,14 @@ struct NodalLoad {
   TimeFunction function;
 };
 
+// A prescribed displacement history on one constrained translation DOF: u_dof(t) = value · function(t)
+// (docs/theory.md §8.6).
+struct PrescribedMotion {
+  Index dof = 0;
+  double value = 0.0;
+  TimeFunction function;
+};
+
 class Model final : public SemiDiscreteSystem {
  public:
   // normals: initial unit nodal normals p_i0 (lib/nodal_normals.hpp). Throws if an element fails the
@@ -91,6 +99,14 @@ class Model final : public SemiDiscreteSystem {
   const std::vector<FollowerPressure>& follower_pressures() const { return follower_; }
   void set_unsymmetric_load_stiffness(bool full) { full_load_tangent_ = full; }
   void set_rayleigh_damping(double mass_coefficient, double stiffness_coefficient);
+  // Prescribed displacement histories (docs/theory.md §8.6). Every DOF must be a constrained translation of
+  // dofs() (throws std::invalid_argument otherwise) and appear once.
+  void set_prescribed_motion(std::vector<PrescribedMotion> motion);
+  const std::vector<PrescribedMotion>& prescribed_motion() const { return prescribed_; }
+  bool has_prescribed_motion() const override { return !prescribed_.empty(); }
+  const std::vector<Index>& prescribed_dofs() const override { return prescribed_dofs_; }
+  void prescribed_displacement(double t, double* u) const override;
+  void prescribed_velocity(double t, double* v) const override;
   bool has_damping() const override { return !damping_.values.empty(); }
   void damping_force(const Eigen::VectorXd& v, double* out) const override;
   void add_damping_matrix(double c, SparseMatrix& J) const override;
@@ -148,6 +164,8 @@ class Model final : public SemiDiscreteSystem {
   std::vector<FollowerPressure> follower_;
   bool full_load_tangent_ = false;
   SparseMatrix damping_;  // empty values: no damping
+  std::vector<PrescribedMotion> prescribed_;  // sorted by dof
+  std::vector<Index> prescribed_dofs_;
 
   // Per-step element state at u_n for algorithmic_internal() (CR9Shell::StepState): u_n is fixed during a
   // step's Newton iterations, so its frame, local increments and membrane products are computed at the

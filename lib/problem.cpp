@@ -25,18 +25,49 @@ Model make_model(const Discretization& d, const CaseMaterial& material) {
   }
   Model model(d.mesh, d.normals, shell_material(material), d.dofs, std::move(loads));
   model.set_follower_pressures(d.follower_pressures);
+  std::vector<PrescribedMotion> motion;
+  for (const auto& pd : d.prescribed) motion.push_back({DofMap::dof(pd.node, pd.component), pd.value, pd.function});
+  model.set_prescribed_motion(std::move(motion));
   return model;
 }
+
+namespace {
+
+// The displaced state of an initial_displacement CSV (read and checked by build_discretization): the listed
+// nodes' translations and, if given, directors (charts selected for them); the others as in the reference state.
+State state_from_displacement_field(const Model& model, const Discretization& disc) {
+  State s = model.initial_state();
+  for (const auto& [node, x] : disc.initial_displacement_field) {
+    s.u.segment<3>(DofMap::dof(node, 0)) = x.head<3>();
+    if (!disc.initial_displacement_directors) continue;
+    const Vec3 p = x.tail<3>();
+    const size_t sn = static_cast<size_t>(node);
+    s.charts[sn] = select_chart(p);
+    s.u.segment<2>(DofMap::dof(node, 3)) = chart_coordinates(p, s.charts[sn]);
+  }
+  return s;
+}
+
+// Prescribed displacement histories (docs/theory.md §8.6) start at g(0) with the rate ġ(0⁺).
+State with_prescribed_start(const Model& model, State s) {
+  model.prescribed_displacement(s.t, s.u.data());
+  model.prescribed_velocity(s.t, s.v.data());
+  return s;
+}
+
+}  // namespace
 
 State Problem::initial_state() const {
   State s = model->initial_state();
   if (!spec.initial_displacement.empty()) {
-    // initial_displacement (docs/manual.md §2.6): d and p of a VTU, charts selected for those directors and
-    // adopted by the model (its director constraints follow the charts); t = 0 whatever the VTU's time.
+    // initial_displacement (docs/manual.md §2.6): d and p of a VTU (or of a CSV), charts selected for those
+    // directors and adopted by the model (its director constraints follow the charts); t = 0 whatever the
+    // VTU's time.
     bool has_time = false;
     State d;
     try {
-      d = state_from_vtu(*model, spec.initial_displacement, &has_time);
+      d = disc.initial_displacement_from_csv ? state_from_displacement_field(*model, disc)
+                                             : state_from_vtu(*model, spec.initial_displacement, &has_time);
     } catch (const std::exception& e) {
       throw std::runtime_error(spec.initial_displacement_where + ": " + e.what());
     }
@@ -53,10 +84,10 @@ State Problem::initial_state() const {
       const Vec3 w = si < disc.initial_director_rate.size() ? disc.initial_director_rate[si] : Vec3::Zero();
       s.v.segment<2>(k + 3) = chart_coordinates(w - w.dot(p) * p, s.charts[si]);
     }
-    return s;
+    return with_prescribed_start(*model, std::move(s));
   }
   if (disc.initial_velocity.size() == s.v.size()) s.v = disc.initial_velocity;
-  return s;
+  return with_prescribed_start(*model, std::move(s));
 }
 
 Problem make_problem(CaseSpec spec) {

@@ -14,4 +14,9 @@ void SemiDiscreteSystem::inertia_force(const Eigen::VectorXd& u, const Eigen::Ve
   for (Index i = 0; i < num_dofs(); ++i) out[i] += fm[i];
 }
 
+const std::vector<Index>& SemiDiscreteSystem::prescribed_dofs() const {
+  static const std::vector<Index> none;
+  return none;
+}
+
 }  // namespace shelldyn

@@ -60,8 +60,20 @@ class SemiDiscreteSystem {
   virtual bool has_damping() const { return false; }
   virtual void damping_force(const Eigen::VectorXd& /*v*/, double* /*out*/) const {}       // out = C v
   virtual void add_damping_matrix(double /*c*/, SparseMatrix& /*J*/) const {}              // J += c C
+  // Prescribed displacement histories (docs/theory.md §8.6): constrained translation DOFs whose value follows
+  // g(t) instead of staying 0. Integrators set them at t_{n+1} before solving the step (the constrained rows of
+  // the residual are zero, so Newton keeps them there), take their rates from the scheme's own relations, and
+  // accumulate the work of their reactions. Default: none.
+  virtual bool has_prescribed_motion() const { return false; }
+  // The prescribed DOFs (sorted, all of them constrained by dofs()).
+  virtual const std::vector<Index>& prescribed_dofs() const;
+  // Writes g(t) into the prescribed entries of u, resp. the right derivative ġ(t⁺) into those of v; other
+  // entries are left unchanged.
+  virtual void prescribed_displacement(double /*t*/, double* /*u*/) const {}
+  virtual void prescribed_velocity(double /*t*/, double* /*v*/) const {}
   virtual Invariants invariants(const State& s) const = 0;
-  // Time after which F_ext vanishes identically (+inf if never; 0 if there are no loads).
+  // Time after which F_ext vanishes identically and prescribed displacements stop moving (+inf if never; 0 if
+  // there are no loads).
   virtual double loads_end() const = 0;
 
   // Re-selects director charts between steps (docs/theory.md §2.3), converting u, v, a so that p, ṗ, p̈

@@ -90,6 +90,50 @@ double TimeFunction::operator()(double t) const {
   return 0.0;  // unreachable; keeps -Wreturn-type quiet
 }
 
+double TimeFunction::rate(double t) const {
+  switch (kind_) {
+    case Kind::Constant:
+      return 0.0;
+    case Kind::Ramp:
+      return (t >= 0.0 && t < a_) ? 1.0 / a_ : 0.0;
+    case Kind::Hat:
+      if (t < 0.0 || t >= 2.0 * a_) return 0.0;
+      return t < a_ ? 1.0 / a_ : -1.0 / a_;
+    case Kind::Triangle:
+      if (t < 0.0 || t >= b_) return 0.0;
+      return t < a_ ? 1.0 / a_ : -1.0 / (b_ - a_);
+    case Kind::Table: {
+      if (t < points_.front().first || t >= points_.back().first) return 0.0;
+      // The piece [t_k, t_{k+1}) that holds t.
+      auto hi = std::upper_bound(points_.begin(), points_.end(), t,
+                                 [](double v, const std::pair<double, double>& p) { return v < p.first; });
+      auto lo = hi - 1;
+      return (hi->second - lo->second) / (hi->first - lo->first);
+    }
+  }
+  return 0.0;
+}
+
+double TimeFunction::end_of_variation() const {
+  switch (kind_) {
+    case Kind::Constant:
+      return 0.0;
+    case Kind::Ramp:
+      return a_;
+    case Kind::Hat:
+      return 2.0 * a_;
+    case Kind::Triangle:
+      return b_;
+    case Kind::Table: {
+      // Walk back over the trailing run of equal values: f is constant from the first of them on.
+      size_t k = points_.size() - 1;
+      while (k > 0 && points_[k - 1].second == points_.back().second) --k;
+      return k == 0 ? 0.0 : std::max(points_[k].first, 0.0);
+    }
+  }
+  return std::numeric_limits<double>::infinity();
+}
+
 double TimeFunction::end_of_support() const {
   const double inf = std::numeric_limits<double>::infinity();
   switch (kind_) {

@@ -31,6 +31,13 @@ class TimeFunction {
   TimeFunction() : TimeFunction(constant()) {}
 
   double operator()(double t) const;
+  // Right derivative f'(t⁺): every function here is piecewise linear, so this is the slope of the piece that
+  // starts at t (0 where f is constant). Prescribed displacement histories take their initial velocity
+  // from it (docs/theory.md §8.6).
+  double rate(double t) const;
+  // Time after which f is constant for good (0 if it never changes for t > 0). A prescribed displacement
+  // a·f(t) stops moving then, and its supports do no more work (docs/theory.md §8.6).
+  double end_of_variation() const;
   // Time after which f is identically 0, or +inf if it never vanishes for good. Loads whose
   // functions have all ended leave the system free (docs/benchmarks.md §0: H = K + V_int afterwards).
   double end_of_support() const;

@@ -22,7 +22,7 @@ import os
 import sys
 
 STANDARD = ["step", "t", "dt", "kinetic", "strain", "external_work", "total", "rel_drift", "Lx", "Ly", "Lz",
-            "Jx", "Jy", "Jz", "nonlinear_iters", "linear_setups", "wall_s", "damping_work"]
+            "Jx", "Jy", "Jz", "nonlinear_iters", "linear_setups", "wall_s", "damping_work", "prescribed_work"]
 
 UNITS = {
     "SI": {"t": "s", "E": "J", "L": "kg m/s", "J": "kg m²/s", "u": "m", "v": "m/s", "r": "N", "p": "1"},
@@ -98,6 +98,7 @@ def main():
     t = c["t"]
     tlabel = f"time t [{U['t']}]"
     damp = c.get("damping_work")
+    presc = c.get("prescribed_work")  # work of prescribed displacements (docs/manual.md §2.12)
 
     def mark_loads(ax):
         if loads_end is not None and math.isfinite(loads_end) and 0 < loads_end <= t[-1]:
@@ -112,6 +113,8 @@ def main():
     ax.plot(t, c["strain"], color="C1", lw=1.4, ls="-.", label="strain V")
     if damp:
         ax.plot(t, damp, color="C2", lw=1.4, ls="--", label="damping work W_damp")
+    if presc:
+        ax.plot(t, presc, color="C3", lw=1.4, ls=":", label="prescribed-motion work W_presc")
     ax.set_ylabel(f"energy [{U['E']}]")
     ax.set_title(f"{title}: energy")
     ax.legend(fontsize=8, loc="best")
@@ -122,7 +125,7 @@ def main():
     axb.plot(t, [h - H0 for h in c["total"]], color="k", lw=1.2)
     axb.set_ylabel(f"H − H(0) [{U['E']}]")
     axb.ticklabel_format(axis="y", style="sci", scilimits=(-2, 3))
-    axb.text(0.01, 0.95, "H = K + V − W_ext" + (" + W_damp" if damp else "") + ": energy balance error",
+    axb.text(0.01, 0.95, "H = K + V − W_ext" + (" − W_presc" if presc else "") + (" + W_damp" if damp else "") + ": energy balance error",
              transform=axb.transAxes, fontsize=8, va="top")
     axb.grid(alpha=0.3)
     mark_loads(axb)

@@ -76,6 +76,8 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
   std::string name() const override { return "em-exact"; }
   std::vector<std::pair<std::string, std::string>> settings() const override { return resolved_; }
   double external_work() const override { return work_; }
+  double prescribed_work() const override { return prescribed_work_; }
+  bool supports_prescribed_motion() const override { return true; }
   const Data& diagnostics() const override { return diag_; }
 
   // Checkpoint (docs/architecture.md "Checkpoints and resume"): the State carries d, v and, in
@@ -89,6 +91,7 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
     if (!newton_) throw std::logic_error("em-exact: save() before initialize()");
     c.exact = true;
     c.scalars["W_ext"] = work_;
+    c.scalars["W_presc"] = prescribed_work_;
     c.scalars["steps"] = static_cast<double>(steps_);
     c.scalars["last_h"] = last_h_;
     c.scalars["diag_dissipation"] = diag_.dissipation;
@@ -111,6 +114,7 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
       throw std::runtime_error("em-exact: the checkpoint has no director velocities (State::pdot) for " +
                                std::to_string(nn_) + " nodes; it was not written by em-exact");
     work_ = c.scalar("W_ext");
+    prescribed_work_ = c.scalars.count("W_presc") ? c.scalar("W_presc") : 0.0;
     steps_ = static_cast<long>(c.scalar("steps"));
     last_h_ = c.scalar("last_h");
     diag_.dissipation = c.scalar("diag_dissipation");
@@ -146,7 +150,7 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
     K_ = M_;
     for (Eigen::VectorXd* v : {&un_, &umid_, &fint_, &r_, &last_u_}) v->setZero(n);
     for (Eigen::VectorXd* v : {&vn_, &wn_, &pn_, &p1_, &pmid_, &v1_, &w1_, &mv_, &mw_, &fd_, &g_}) v->setZero(3 * nn_);
-    work_ = 0.0;
+    work_ = prescribed_work_ = 0.0;
     diag_ = Data{};
     diag_.min_step_dissipation = std::numeric_limits<double>::infinity();
     sys.rechart(s, hysteresis_);
@@ -335,6 +339,7 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
       }
       for (Index d : sys.dofs().constrained_dofs()) u[d] = un_[d];  // constrained entries stay bitwise u_n
     }
+    sys.prescribed_displacement(t1, u.data());  // prescribed DOFs at g(t_{n+1}) (docs/theory.md §8.6)
     last_u_ = u;
     last_r_.setZero(n);
     // Scale of the unknowns 1/max(1, |u_n,i|): the solver's round-off guard of the contraction test is relative.
@@ -377,6 +382,12 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
       dw += fd_.segment<3>(3 * i).dot(u.segment<3>(k) - un_.segment<3>(k));
     }
     work_ += dw;
+    // Reaction work of the prescribed translations (docs/theory.md §8.6): their rows of the translational
+    // balance, Σ (M_d Δv/Δt + F*_int − F_ext(t_mid))_c Δd_c, at the accepted iterate (fint_ is its force).
+    for (Index dof : sys.prescribed_dofs()) {
+      const Index i = dof / kDofsPerNode, c = dof % kDofsPerNode;
+      prescribed_work_ += (mv_[3 * i + c] + fint_[dof] - fd_[3 * i + c]) * (u[dof] - un_[dof]);
+    }
     // New state: v, w from the trapezoidal relations; q̇ and q̈ entries hold the chart's minor components of
     // w and Δw/Δt (for output only: the scheme's state is (d, p, v, w)); a_d = Δv/Δt.
     for (int i = 0; i < nn_; ++i) {
@@ -414,7 +425,7 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
   std::vector<double> Un_;
   Eigen::VectorXd un_, umid_, fint_, r_, last_u_, last_r_, uscale_;
   Eigen::VectorXd vn_, wn_, pn_, p1_, pmid_, v1_, w1_, mv_, mw_, fd_, g_;
-  double work_ = 0.0;
+  double work_ = 0.0, prescribed_work_ = 0.0;
   double last_h_ = 0.0;
   long steps_ = 0;
   Data diag_;

@@ -127,6 +127,8 @@ class NewmarkFamily final : public Integrator {
   std::vector<std::pair<std::string, std::string>> settings() const override { return resolved_; }
   double external_work() const override { return work_; }
   double damping_work() const override { return damping_work_; }
+  double prescribed_work() const override { return prescribed_work_; }
+  bool supports_prescribed_motion() const override { return true; }
 
   // Checkpoint (docs/architecture.md "Checkpoints and resume"): besides the State (u, v, a, charts)
   // a step depends on W_ext, the step counter (messages), the last step size (modified Newton
@@ -138,6 +140,7 @@ class NewmarkFamily final : public Integrator {
     c.exact = true;
     c.scalars["W_ext"] = work_;
     c.scalars["W_damp"] = damping_work_;
+    c.scalars["W_presc"] = prescribed_work_;
     c.scalars["steps"] = static_cast<double>(steps_);
     c.scalars["last_h"] = last_h_;
     c.scalars["energy0"] = energy0_;  // scale of the energy floor (initialize() would take the restored state's)
@@ -152,6 +155,7 @@ class NewmarkFamily final : public Integrator {
       throw std::runtime_error(name_ + ": checkpoint state has the wrong size for this model");
     work_ = c.scalar("W_ext");
     damping_work_ = c.scalar("W_damp");
+    prescribed_work_ = c.scalars.count("W_presc") ? c.scalar("W_presc") : 0.0;
     steps_ = static_cast<long>(c.scalar("steps"));
     last_h_ = c.scalar("last_h");
     energy0_ = c.scalar("energy0");
@@ -173,7 +177,7 @@ class NewmarkFamily final : public Integrator {
     K_ = M_;
     for (Eigen::VectorXd* v : {&un_, &vn_, &an_, &umid_, &vmid_, &amid_, &fint_, &fm_, &fext_, &fint_n_, &fext_n_, &tmp_})
       v->setZero(n);
-    work_ = damping_work_ = 0.0;
+    work_ = damping_work_ = prescribed_work_ = 0.0;
     sys.rechart(s, hysteresis_);
     // Consistent initial acceleration (docs/theory.md §6.4 start-up): M(u0) a0 = F_ext − F_int − F_m.
     sys.mass(s.u, s.charts, M_);
@@ -276,6 +280,7 @@ class NewmarkFamily final : public Integrator {
         sys.external(tmid, umid_, charts, fext_.data());
       }
     };
+    bool keep_constrained = false;  // true: the residual keeps its constrained rows (the reactions)
     auto residual = [&](const double* u, double* r) {
       const Eigen::Map<const Eigen::VectorXd> uu(u, n);
       midpoint_state(u);
@@ -296,7 +301,7 @@ class NewmarkFamily final : public Integrator {
       external_force(u);
       Eigen::Map<Eigen::VectorXd> rr(r, n);
       rr = fm_ + fint_ - fext_;  // = −P̄ (§6.4)
-      zero_constrained(sys.dofs(), r);
+      if (!keep_constrained) zero_constrained(sys.dofs(), r);
       if (!rr.allFinite()) throw std::runtime_error("non-finite residual");
     };
     bool replayed = false;
@@ -335,6 +340,7 @@ class NewmarkFamily final : public Integrator {
 
     Eigen::VectorXd u = un_;  // predictor u_{n+1}^(0) = u_n (§6.4)
     if (newmark_predictor_ && !full_newton) u += h * vn_ + (0.5 * h * h) * an_;
+    sys.prescribed_displacement(t1, u.data());  // prescribed DOFs at g(t_{n+1}); Newton leaves them there
     uscale_ = (1.0 / un_.array().abs().max(1.0)).matrix();
     // Stopping rule of modified Newton (constructor): cc ≤ cc_tol (in NewtonSolver), the energy floor
     // E_k ≤ e_floor·E_sys, or the scaled step test once (round-off reached).
@@ -360,6 +366,12 @@ class NewmarkFamily final : public Integrator {
     if (!r.converged) {
       *why = r.message + " (cc = " + std::to_string(r.energy_ratio) + ", iterations = " + std::to_string(r.iterations) + ")";
       return false;
+    }
+    if (sys.has_prescribed_motion()) {  // reaction work Σ r_c Δu_c of the prescribed DOFs (docs/theory.md §8.6)
+      keep_constrained = true;
+      rc_.resize(n);
+      residual(u.data(), rc_.data());
+      for (Index dof : sys.prescribed_dofs()) prescribed_work_ += rc_[dof] * (u[dof] - un_[dof]);
     }
     // Discrete external work with the scheme's own load evaluation (docs/benchmarks.md §0).
     midpoint_state(u.data());
@@ -393,7 +405,8 @@ class NewmarkFamily final : public Integrator {
   std::unique_ptr<NewtonSolver> newton_, full_newton_;  // full_newton_: fallback of modified Newton
   SparseMatrix M_, K_;
   Eigen::VectorXd un_, vn_, an_, umid_, vmid_, amid_, fint_, fm_, fext_, fint_n_, fext_n_, tmp_, uscale_;
-  double work_ = 0.0, damping_work_ = 0.0;
+  double work_ = 0.0, damping_work_ = 0.0, prescribed_work_ = 0.0;
+  Eigen::VectorXd rc_;  // residual with its constrained rows (prescribed-motion work)
   double energy0_ = 0.0;  // K + V at initialize() (scale of the energy floor)
   double e_floor_ = 0.0;
   double step_tol_ = 1e-14;

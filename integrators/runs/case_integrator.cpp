@@ -34,12 +34,13 @@ std::unique_ptr<Integrator> make_case_integrator(const CaseSpec& spec, const std
   const bool own = integrator.empty() || integrator == spec.integrator.name;
   const std::string name = own ? spec.integrator.name : integrator;
   if (name == "static") throw std::invalid_argument("integrator 'static' is the static solver: use `shelldyn static CASE`");
+  std::unique_ptr<Integrator> made;
   try {
     IntegratorSettings settings =
         own ? IntegratorSettings(spec.integrator)
             : IntegratorSettings(name, settings_understood_by(name, spec.integrator.settings));
     for (const auto& [k, v] : overrides) settings.set(k, v);
-    return make_integrator(settings, dt);
+    made = make_integrator(settings, dt);
   } catch (const std::invalid_argument& e) {
     const std::string msg = e.what();
     // 0. IntegratorSettings names the key exactly: "integrator.KEY: ..."
@@ -75,10 +76,19 @@ std::unique_ptr<Integrator> make_case_integrator(const CaseSpec& spec, const std
       throw std::invalid_argument(spec.integrator.where + ": integrator.name: " + msg);
     throw std::invalid_argument(spec.integrator.where + ": integrator: " + msg);
   }
+  check_prescribed_motion_support(spec, made->name(), made->supports_prescribed_motion());
+  return made;
+}
+
+void check_prescribed_motion_support(const CaseSpec& spec, const std::string& integrator, bool supported) {
+  if (spec.prescribed_displacements.empty() || supported) return;
+  throw std::invalid_argument(spec.prescribed_displacements.front().where + ": integrator '" +
+                              integrator + "' does not follow prescribed displacement histories (use em-galpha, em-exact, "
+                              "galpha, midpoint or newmark)");
 }
 
 void validate_case_integrator(const CaseSpec& spec) {
-  if (spec.integrator.name == "static") return;
+  if (spec.integrator.name == "static") return check_prescribed_motion_support(spec, "static", false);
   make_case_integrator(spec, "", {}, spec.time.dt);
 }
 

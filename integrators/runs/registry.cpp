@@ -40,13 +40,15 @@ std::vector<std::pair<std::string, std::string>> integrator_catalogue() {
   for (const auto& kv : registry()) {
     // The settings it reads, with their defaults (docs/manual.md §3), from a probe instance.
     std::string settings;
+    bool prescribed = false;  // follows prescribed_displacements (docs/manual.md §2.12)
     try {
       IntegratorSettings probe(kv.first, {});
-      kv.second.factory(probe, 1e-3);
+      prescribed = kv.second.factory(probe, 1e-3)->supports_prescribed_motion();
       for (const auto& [key, value] : probe.resolved()) settings += (settings.empty() ? "" : ", ") + key + "=" + value;
     } catch (const std::exception&) {
     }
-    out.emplace_back(kv.first, kv.second.summary + (settings.empty() ? "" : "\n      settings: " + settings));
+    out.emplace_back(kv.first, kv.second.summary + (prescribed ? "" : " [refuses prescribed_displacements]") +
+                                   (settings.empty() ? "" : "\n      settings: " + settings));
   }
   return out;
 }

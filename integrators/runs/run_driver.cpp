@@ -47,6 +47,7 @@ void fill_summary_json(JsonFields& j, const RunSummary& s) {
   j.set("E_ref", s.E_ref);
   j.set("H_final", s.H_final);
   if (s.damped) j.set("damping_work", s.damping_work);
+  if (s.prescribed) j.set("prescribed_work", s.prescribed_work);
   j.set("max_rel_energy_drift_after_loads", s.max_rel_drift);
   j.set("final_rel_energy_drift", s.final_rel_drift);
   j.set("max_abs_dL_after_loads", s.max_dL);
@@ -272,6 +273,7 @@ RunSummary run_dynamic(Problem& problem, const RunOptions& o) {
   sum.settings = integrator->settings();
   sum.t_end = t_end;
   sum.damped = model.has_damping();  // the summary then names H = K + V − W_ext + W_damp
+  sum.prescribed = model.has_prescribed_motion();  // ... and − W_presc
   spec.integrator.name = sum.integrator;  // run.json shows what was actually run
   spec.integrator.settings = sum.settings;
   spec.time.dt = dt;
@@ -307,7 +309,10 @@ RunSummary run_dynamic(Problem& problem, const RunOptions& o) {
     std::vector<std::string> names;
     for (const auto& m : monitors) names.push_back(m.name);
     // damping_work: energy dissipated by Rayleigh damping (docs/theory.md §8.5), only for damped models.
-    const std::vector<std::string> extra = model.has_damping() ? std::vector<std::string>{"damping_work"} : std::vector<std::string>{};
+    // prescribed_work: work of the prescribed displacement histories (docs/theory.md §8.6), only when there are some.
+    std::vector<std::string> extra;
+    if (model.has_damping()) extra.push_back("damping_work");
+    if (model.has_prescribed_motion()) extra.push_back("prescribed_work");
     if (spec.output.history)
       history = resume ? std::make_unique<HistoryWriter>(o.out_dir + "/history.csv", extra, names,
                                                          static_cast<long long>(resume->number("history_bytes")))
@@ -432,8 +437,10 @@ RunSummary run_dynamic(Problem& problem, const RunOptions& o) {
 
   auto observe = [&](const StepReport& rep, bool last) {
     const Invariants inv = model.invariants(state);
-    const double H = inv.kinetic + inv.strain - integrator->external_work() + integrator->damping_work();
-    E_seen = std::max({E_seen, inv.kinetic + inv.strain, std::abs(integrator->external_work())});
+    const double H = inv.kinetic + inv.strain - integrator->external_work() - integrator->prescribed_work() +
+                     integrator->damping_work();
+    E_seen = std::max({E_seen, inv.kinetic + inv.strain, std::abs(integrator->external_work()),
+                       std::abs(integrator->prescribed_work())});
     if (out_index == 0) sum.H0 = H;
     if (!have_ref && state.t >= loads_end - 1e-12 * dt) {
       have_ref = true;
@@ -462,6 +469,7 @@ RunSummary run_dynamic(Problem& problem, const RunOptions& o) {
       sum.max_strain_ratio = std::max(sum.max_strain_ratio, inv.strain / (inv.kinetic + inv.strain));
     sum.H_final = H;
     sum.damping_work = integrator->damping_work();
+    sum.prescribed_work = integrator->prescribed_work();
     const double wall = elapsed();
     std::vector<double> mon;
     const bool vtu_now = pvd && out_index % vtu_every == 0;
@@ -485,7 +493,8 @@ RunSummary run_dynamic(Problem& problem, const RunOptions& o) {
       row.linear_setups = sum.totals.linear_setups;
       row.wall_s = wall;
       row.monitors = mon;
-      if (model.has_damping()) row.extra = {integrator->damping_work()};
+      if (model.has_damping()) row.extra.push_back(integrator->damping_work());
+      if (model.has_prescribed_motion()) row.extra.push_back(integrator->prescribed_work());
       history->write(row);
     }
     if (vtu_now) {
@@ -643,9 +652,11 @@ void print_run_summary(std::ostream& out, const RunSummary& s) {
   line("linear setups / factorizations", std::to_string(s.totals.linear_setups) + " / " + std::to_string(s.totals.factorizations));
   line("director chart switches", std::to_string(s.totals.chart_switches));
   // Damped models (docs/theory.md §8.5): the conserved total includes the dissipated energy W_damp.
-  line(s.damped ? "energy H = K + V - W_ext + W_damp: H0, H_ref" : "energy H = K + V - W_ext: H0, H_ref",
+  line(std::string("energy H = K + V - W_ext") + (s.prescribed ? " - W_presc" : "") + (s.damped ? " + W_damp" : "") +
+           ": H0, H_ref",
        num(s.H0) + ", " + num(s.H_ref) + " (at t = " + num(s.t_ref) + ")");
   if (s.damped) line("damping work W_damp (end)", num(s.damping_work));
+  if (s.prescribed) line("prescribed-motion work W_presc (end)", num(s.prescribed_work));
   line("max |H - H_ref|/(K+V)_ref after loads", num(s.max_rel_drift));
   line("max |L - L_ref| after loads", num(s.max_dL) + " (|L_ref| = " + num(s.ref_L) + ")");
   line("max |J - J_ref| after loads", num(s.max_dJ) + " (|J_ref| = " + num(s.ref_J) + ")");

@@ -119,6 +119,10 @@ struct RunSummary {
   // Rayleigh-damped model (docs/theory.md §8.5): H then includes + W_damp; damping_work = W_damp at the end.
   bool damped = false;
   double damping_work = 0.0;
+  // Prescribed displacement histories (docs/theory.md §8.6): H then includes − W_presc; prescribed_work = W_presc
+  // at the end.
+  bool prescribed = false;
+  double prescribed_work = 0.0;
   std::vector<std::pair<std::string, double>> final_monitors;
   double wall_seconds = 0.0;
   // CPU seconds of the run: the calling thread's when the run is single-threaded (as every run of

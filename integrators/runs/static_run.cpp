@@ -1,5 +1,7 @@
 #include "integrators/runs/static_run.hpp"
 
+#include "integrators/runs/case_integrator.hpp"
+
 #include "integrators/integrator_settings.hpp"
 #include "integrators/sundials/sundials_info.hpp"
 #include "lib/reactions.hpp"
@@ -91,6 +93,7 @@ StaticOptions static_options(const CaseSpec& spec, const Discretization* disc) {
 std::vector<StaticRow> run_static(Problem& problem, const std::string& out_dir, std::ostream* log,
                                   StaticReport* report_out, const State* start) {
   const CaseSpec& spec = problem.spec;
+  check_prescribed_motion_support(spec, "static", false);  // load stepping follows no time history
   const StaticOptions options = static_options(spec, &problem.disc);
   Model& model = *problem.model;
   // Follower loads have a non-symmetric tangent: in full with the LU solver (quadratic Newton), else its

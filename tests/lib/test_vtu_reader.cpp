@@ -240,7 +240,7 @@ TEST(VtuReader, InitialDisplacementAndVelocityFromAVtu) {
   EXPECT_NE(error_of([&] { panel("initial_displacement: {field: " + vtu + "}\ninitial_velocity: {translation: [1, 0, 0]}\n"); })
                 .find("initial_displacement: the initial velocity must then be a field"),
             std::string::npos);
-  EXPECT_NE(error_of([&] { panel("initial_displacement: {field: d.csv}\n"); }).find("is not a .vtu file"), std::string::npos);
+  EXPECT_NE(error_of([&] { panel("initial_displacement: {field: d.txt}\n"); }).find("is neither a .vtu nor a .csv file"), std::string::npos);
   Problem big = make_problem(load_case_from_string(
       "mesh: {generator: cylindrical_panel, radius: 1.0, angle: 1.2, length: 1.5, n_arc: 3, n_axial: 2}\n"
       "material: {E: 1.0e6, nu: 0.3, rho: 2, thickness: 0.05}\nintegrator: {name: em-galpha}\ntime: {dt: 0.1, t_end: 1}\n",
@@ -250,3 +250,71 @@ TEST(VtuReader, InitialDisplacementAndVelocityFromAVtu) {
   EXPECT_EQ(e.rfind("panel.yaml:", 0), 0u) << e;
   EXPECT_NE(e.find("initial_displacement.field: " + (dir / "big.vtu").string() + ": has 35 points"), std::string::npos) << e;
 }
+
+namespace shelldyn {
+namespace {
+
+// initial_displacement: {field: FILE.csv} (docs/manual.md §2.6): the same displaced state as from a VTU, read
+// from "node,ux,uy,uz[,px,py,pz]" lines (the CSV reader of initial_velocity fields). Nodes not listed keep the
+// reference; without director columns the directors stay the reference ones. Errors name the case line and
+// the file (and its line).
+TEST(VtuReader, InitialDisplacementFromACsvEqualsTheVtuOne) {
+  Problem pb = panel();
+  const State s = moving_state(*pb.model);
+  const fs::path dir = scratch_dir("initial_displacement_csv");
+  const std::string vtu = (dir / "state.vtu").string(), csv = (dir / "state.csv").string();
+  write_vtu(vtu, pb.model->mesh(), state_fields(*pb.model, s));
+  {
+    std::ofstream f(csv);
+    f.precision(17);
+    f << "node,ux,uy,uz,px,py,pz\n";
+    for (int i = 0; i < pb.model->mesh().num_nodes(); ++i) {
+      const Vec3 d = s.u.segment<3>(DofMap::dof(i, 0)), p = pb.model->director(s, i);
+      f << i << "," << d.x() << "," << d.y() << "," << d.z() << "," << p.x() << "," << p.y() << "," << p.z() << "\n";
+    }
+  }
+  const State from_vtu = panel("initial_displacement: {field: " + vtu + "}\n").initial_state();
+  Problem from_csv_problem = panel("initial_displacement: {field: " + csv + "}\n");
+  const State from_csv = from_csv_problem.initial_state();
+  EXPECT_EQ(from_csv.charts.size(), from_vtu.charts.size());
+  for (size_t i = 0; i < from_csv.charts.size(); ++i) EXPECT_EQ(from_csv.charts[i].l, from_vtu.charts[i].l) << i;
+  EXPECT_LE((from_csv.u - s.u).cwiseAbs().maxCoeff(), 1e-15);
+  EXPECT_LE((from_csv.u - from_vtu.u).cwiseAbs().maxCoeff(), 1e-15);
+  EXPECT_EQ(from_csv.v.cwiseAbs().maxCoeff(), 0.0);  // at rest unless a velocity field is given
+  const double V = pb.model->invariants(s).strain;
+  ASSERT_GT(V, 0.0);
+  EXPECT_NEAR(from_csv_problem.model->invariants(from_csv).strain, V, 1e-12 * V);
+
+  // Translations only, for two nodes: the others and every director stay at the reference.
+  {
+    std::ofstream f(csv);
+    f << "node,ux,uy,uz\n3,0.1,0.2,0.3\n\n7,-0.1,0,0\n";
+  }
+  const State part = panel("initial_displacement: {field: " + csv + "}\n").initial_state();
+  State expected = pb.model->initial_state();
+  expected.u.segment<3>(DofMap::dof(3, 0)) = Vec3(0.1, 0.2, 0.3);
+  expected.u.segment<3>(DofMap::dof(7, 0)) = Vec3(-0.1, 0, 0);
+  EXPECT_EQ((part.u - expected.u).cwiseAbs().maxCoeff(), 0.0);
+
+  // Errors.
+  auto csv_error = [&](const std::string& text, const std::string& extra = "") {
+    std::ofstream(csv) << text;
+    return error_of([&] { panel(extra + "initial_displacement: {field: " + csv + "}\n").initial_state(); });
+  };
+  std::string e = csv_error("node,ux,uy,uz,px,py,pz\n2,0,0,0,0,0,2\n");
+  EXPECT_EQ(e.rfind("panel.yaml:5: initial_displacement.field: " + csv + ": the director (px, py, pz) of node 2 has length 2", 0), 0u) << e;
+  e = csv_error("node,ux,uy,uz\n2,0,0\n");
+  EXPECT_NE(e.find(csv + ":2: expected a node index in [0, 25) and 3 finite numbers"), std::string::npos) << e;
+  e = csv_error("id,ux,uy,uz\n");
+  EXPECT_NE(e.find(":1: expected the header 'node,ux,uy,uz' or 'node,ux,uy,uz,px,py,pz'"), std::string::npos) << e;
+  e = csv_error("node,ux,uy,uz\n0,0,0,0.5\n", "boundary_conditions: [{set: x0, fix: [uz]}]\n");
+  EXPECT_NE(e.find("node 0 has uz = 0.5"), std::string::npos) << e;
+  EXPECT_NE(e.find("which a boundary condition fixes at 0"), std::string::npos) << e;
+  EXPECT_NE(error_of([&] { panel("initial_displacement: {field: " + (dir / "missing.csv").string() + "}\n"); })
+                .find("cannot open the displacement field"),
+            std::string::npos);
+  fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace shelldyn
