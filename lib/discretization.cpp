@@ -383,14 +383,13 @@ Discretization build_discretization(const CaseSpec& spec) {
           const std::vector<int>& held = find_set(mesh, bc.set, bc.where + ".set");
           if (std::find(held.begin(), held.end(), node) != held.end())
             fail(ps.where + ".dofs", std::string(kTranslation[c]) + " of node " + std::to_string(node) +
-                                         " is prescribed here and fixed by boundary_conditions[" + std::to_string(b) +
-                                         "] (set '" + bc.set + "'); a DOF is either fixed or prescribed: remove it from one of them");
+                                         " is also fixed by boundary_conditions[" + std::to_string(b) + "] (keep one of the two)");
         }
         const auto [it, fresh] = prescribed_by.emplace(dof, k);
         if (!fresh)
           fail(ps.where + ".dofs", std::string(kTranslation[c]) + " of node " + std::to_string(node) +
-                                       " is already prescribed by prescribed_displacements[" + std::to_string(it->second) +
-                                       "]; prescribe each DOF once");
+                                       " is also prescribed by prescribed_displacements[" + std::to_string(it->second) +
+                                       "] (prescribe it once)");
         d.dofs.fix(node, c == 0 ? Fix::Ux : c == 1 ? Fix::Uy : Fix::Uz);
         d.prescribed.push_back({node, c, ps.value, ps.function});
       }
@@ -524,10 +523,9 @@ Discretization build_discretization(const CaseSpec& spec) {
         for (int c = 0; c < 3; ++c) {
           const auto it = prescribed_by.find(DofMap::dof(node, c));
           if (it != prescribed_by.end() && vec[c] != 0.0)
-            fail(l.where + ".set", "this force acts along " + std::string(kTranslation[c]) + " on node " + std::to_string(node) +
+            fail(l.where + ".set", "force along " + std::string(kTranslation[c]) + " on node " + std::to_string(node) +
                                        ", which prescribed_displacements[" + std::to_string(it->second) +
-                                       "] prescribes (a prescribed DOF carries a reaction instead: remove the node from the "
-                                       "load's set or the prescription)");
+                                       "] prescribes (drop one of the two)");
         }
     if (l.distribution == LoadDistribution::PerLength) {
       const std::map<int, Vec3> f = edge_line_forces(mesh, nodes, vec);

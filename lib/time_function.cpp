@@ -53,8 +53,8 @@ TimeFunction TimeFunction::table(std::vector<std::pair<double, double>> points) 
     }
     if (k > 0 && !(points[k].first > points[k - 1].first)) {
       std::ostringstream os;
-      os << "table time function: times must be strictly increasing, but point " << k << " has t = "
-         << points[k].first << " after t = " << points[k - 1].first;
+      os << "table: times must increase (point " << k << ": t = " << points[k].first << " after "
+         << points[k - 1].first << ")";
       throw std::invalid_argument(os.str());
     }
   }

@@ -54,6 +54,11 @@ double SundialsBaseline::chart_root(const double* y) {
 }
 
 void SundialsBaseline::initialize(SemiDiscreteSystem& system, State& state) {
+  // Prescribed displacement histories (docs/manual.md §2.12) are not part of the first-order form: refuse them
+  // rather than hold those DOFs at 0 (runs of a case are refused earlier, by make_case_integrator).
+  if (system.has_prescribed_motion())
+    throw std::invalid_argument(name_ + ": prescribed displacement histories (prescribed_displacements) are not supported "
+                                        "by this integrator (use em-galpha, em-exact, galpha, midpoint or newmark)");
   sys_ = &system;
   n_ = system.num_dofs();
   if (!ctx_) ctx_ = std::make_unique<SunContext>();  // one context per integrator object

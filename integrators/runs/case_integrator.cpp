@@ -82,9 +82,8 @@ std::unique_ptr<Integrator> make_case_integrator(const CaseSpec& spec, const std
 
 void check_prescribed_motion_support(const CaseSpec& spec, const std::string& integrator, bool supported) {
   if (spec.prescribed_displacements.empty() || supported) return;
-  throw std::invalid_argument(spec.prescribed_displacements.front().where + ": integrator '" +
-                              integrator + "' does not follow prescribed displacement histories (use em-galpha, em-exact, "
-                              "galpha, midpoint or newmark)");
+  throw std::invalid_argument(spec.prescribed_displacements.front().where + ": integrator '" + integrator +
+                              "' cannot follow them (use em-galpha, em-exact, galpha, midpoint, newmark)");
 }
 
 void validate_case_integrator(const CaseSpec& spec) {

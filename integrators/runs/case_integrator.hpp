@@ -30,7 +30,7 @@ std::unique_ptr<Integrator> make_case_integrator(const CaseSpec& spec, const std
 void validate_case_integrator(const CaseSpec& spec);
 
 // Throws std::invalid_argument "FILE:LINE: prescribed_displacements[0]: integrator 'X'
-// does not follow ..." if the case prescribes displacement histories and the integrator (or solver) named
+// cannot follow them ..." if the case prescribes displacement histories and the integrator (or solver) named
 // `integrator` does not support them (`supported`); make_case_integrator calls it (docs/manual.md §2.12).
 void check_prescribed_motion_support(const CaseSpec& spec, const std::string& integrator, bool supported);
 

@@ -1,4 +1,6 @@
 #include "integrators/runs/compare.hpp"
+
+#include "integrators/runs/case_integrator.hpp"
 #include "integrators/runs/number_text.hpp"
 #include "integrators/runs/executor.hpp"
 #include "integrators/runs/registry.hpp"
@@ -228,7 +230,9 @@ std::vector<CompareRun> expand_compare_runs(const CompareOptions& o) {
       all.insert(all.end(), x.overrides.begin(), x.overrides.end());
       IntegratorSettings check(x.integrator, all, "integrator setting '" + spec + "'");
       try {
-        make_integrator(check, x.dt > 0.0 ? x.dt : 1e-3);
+        const auto made = make_integrator(check, x.dt > 0.0 ? x.dt : 1e-3);
+        // A case with prescribed displacements (docs/manual.md §2.12): refuse an integrator that cannot follow them now.
+        check_prescribed_motion_support(case_spec, made->name(), made->supports_prescribed_motion());
       } catch (const std::exception& e) {
         throw std::invalid_argument("integrator setting '" + spec + "': " + e.what());
       }

@@ -91,7 +91,7 @@ const BadCase kBadCases[] = {
     {"table not increasing",
      kMinimal + "loads:\n  - {set: all, type: force, direction: [0, 0, 1], amplitude: 1,\n"
                 "     function: {type: table, points: [[0, 0], [1, 1], [1, 2]]}}\n",
-     "bad.yaml:8: loads[0].function:", "strictly increasing"},
+     "bad.yaml:8: loads[0].function:", "times must increase"},
     {"time function with a foreign key",
      kMinimal + "loads:\n  - {set: all, type: force, direction: [0, 0, 1], amplitude: 1, function: {type: ramp, t_peak: 1}}\n",
      "bad.yaml:7: loads[0].function.t_peak:", "unknown key"},
