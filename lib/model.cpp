@@ -133,11 +133,10 @@ double Model::internal(const Eigen::VectorXd& u, const std::vector<DirectorChart
   return sum(energy);
 }
 
-double Model::algorithmic_internal(const Eigen::VectorXd& u_n, const Eigen::VectorXd& u_np1,
-                                   const std::vector<DirectorChart>& charts, double alpha_f, double xi,
-                                   double* F, SparseMatrix* K) const {
+// The step cache for (u_n, charts), filled if it holds another start (call with cache.mutex held).
+const std::vector<CR9Shell::StepState>& Model::step_states(const Eigen::VectorXd& u_n,
+                                                            const std::vector<DirectorChart>& charts) const {
   StepCache& cache = *step_cache_;
-  std::lock_guard<std::mutex> lock(cache.mutex);
   const bool same_start = cache.valid && cache.u_n.size() == u_n.size() && cache.charts.size() == charts.size() &&
                           std::memcmp(cache.u_n.data(), u_n.data(), sizeof(double) * static_cast<size_t>(u_n.size())) == 0 &&
                           std::equal(charts.begin(), charts.end(), cache.charts.begin(), [](const DirectorChart& a, const DirectorChart& b) {
@@ -156,6 +155,15 @@ double Model::algorithmic_internal(const Eigen::VectorXd& u_n, const Eigen::Vect
     cache.charts = charts;
     cache.valid = true;
   }
+  return cache.states;
+}
+
+double Model::algorithmic_internal(const Eigen::VectorXd& u_n, const Eigen::VectorXd& u_np1,
+                                   const std::vector<DirectorChart>& charts, double alpha_f, double xi,
+                                   double* F, SparseMatrix* K) const {
+  StepCache& cache = *step_cache_;
+  std::lock_guard<std::mutex> lock(cache.mutex);
+  const std::vector<CR9Shell::StepState>& states = step_states(u_n, charts);
   profile::Scope prof(K ? profile::Section::tangent : profile::Section::internal_force);
   if (F) std::fill(F, F + num_dofs(), 0.0);
   if (K) K->set_zero();
@@ -166,7 +174,7 @@ double Model::algorithmic_internal(const Eigen::VectorXd& u_n, const Eigen::Vect
     gather(e, u_n, un);
     gather(e, u_np1, unp1);
     energy[static_cast<size_t>(e)] = elements_[static_cast<size_t>(e)].algorithmic_internal(
-        cache.states[static_cast<size_t>(e)], un, unp1, element_charts(e, charts), alpha_f, xi, F ? &fe : nullptr,
+        states[static_cast<size_t>(e)], un, unp1, element_charts(e, charts), alpha_f, xi, F ? &fe : nullptr,
         K ? &ke : nullptr);
     if (F) assembler_.add_vector(e, fe, F);
     if (K) assembler_.add_matrix(e, ke, K->values.data());
@@ -448,6 +456,11 @@ double Model::exact_internal(const Eigen::VectorXd& u_n, const Eigen::VectorXd& 
   if (K) K->set_zero();
   std::vector<double> energy(elements_.size(), 0.0), beta_z(elements_.size(), 0.0), diss(elements_.size(), 0.0);
   std::vector<char> guard(elements_.size(), 0);
+  // u_n is fixed during a step: its element state comes from the step cache (as algorithmic_internal()).
+  StepCache& cache = *step_cache_;
+  std::lock_guard<std::mutex> lock(cache.mutex);
+  const std::vector<CR9Shell::StepState>& states = step_states(u_n, charts);
+  profile::Scope prof(K ? profile::Section::tangent : profile::Section::internal_force);
   for_each_element(assembler_, [&](int e) {
     const auto& el = elements_[static_cast<size_t>(e)];
     const auto ch = element_charts(e, charts);
@@ -456,7 +469,7 @@ double Model::exact_internal(const Eigen::VectorXd& u_n, const Eigen::VectorXd& 
     gather(e, u_n, un);
     gather(e, u_np1, u1);
     // Paper force F = T(u_mid)ᵀ f*_L (§6.3 at α_f = ½, ξ = 0) and its symmetric tangent K_mid.
-    const double U1 = el.algorithmic_internal(un, u1, ch, 0.5, 0.0, &fe, K ? &ke : nullptr);
+    const double U1 = el.algorithmic_internal(states[static_cast<size_t>(e)], un, u1, ch, 0.5, 0.0, &fe, K ? &ke : nullptr);
     energy[static_cast<size_t>(e)] = U1;
     const CR9Shell::Vec45 du = u1 - un;
     RigidRows R;

@@ -179,6 +179,8 @@ class Model final : public SemiDiscreteSystem {
     bool valid = false;
   };
   std::unique_ptr<StepCache> step_cache_ = std::make_unique<StepCache>();
+  const std::vector<CR9Shell::StepState>& step_states(const Eigen::VectorXd& u_n,
+                                                      const std::vector<DirectorChart>& charts) const;
 };
 
 }  // namespace shelldyn

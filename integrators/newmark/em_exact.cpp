@@ -33,8 +33,18 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
     if (newton != "full" && newton != "modified")
       throw std::invalid_argument("em-exact.newton: '" + newton + "' (use full or modified)");
     nopt_.modified = (newton == "modified");
-    nopt_.max_setup_calls = s.get("setup_every", 20);
-    nopt_.linear_solver = s.get("linear_solver", "eigen-ldlt");
+    // Modified Newton keeps K̄ while the iteration contracts (as em-galpha: refresh when the observed
+    // contraction ‖Δu_k‖/‖Δu_{k−1}‖ exceeds `refresh`; refresh = 0 restores the fixed count setup_every).
+    nopt_.refresh_contraction = s.get("refresh", nopt_.modified ? 0.03 : 0.0);
+    nopt_.max_setup_calls = s.get("setup_every", nopt_.refresh_contraction > 0 ? 1000000 : 20);
+    // CHOLMOD's supernodal Cholesky as em-galpha (faster solves than Eigen's simplicial LDLᵀ, no hidden threads).
+    nopt_.linear_solver = s.get("linear_solver", "cholmod");
+    // Predictor (theory §5): u_n, or with modified Newton the trapezoidal extrapolation d_n + Δt v_n + Δt²/2 a_n,
+    // p_n + Δt w_n (a failed step is retried from u_n with full Newton).
+    const std::string predictor = s.get("predictor", nopt_.modified ? "trapezoidal" : "none");
+    if (predictor != "none" && predictor != "trapezoidal")
+      throw std::invalid_argument("em-exact.predictor: '" + predictor + "' (use none or trapezoidal)");
+    predictor_ = (predictor == "trapezoidal");
     make_linear_solver(nopt_.linear_solver);
     // KINSOL never stops on its own (tolerances at the bottom of the double range): the iteration hook
     // applies the residual / stagnation rule of theory §5.
@@ -47,13 +57,14 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
     res_tol_ = s.get("res_tol", 1e-12);
     stall_tol_ = s.get("stall_tol", 1e-6);
     stall_ratio_ = s.get("stall_ratio", 0.5);
+    stall_step_ = s.get("stall_step", 1e-6);
     max_cuts_ = s.get("max_cuts", 0);
     hysteresis_ = s.get("hysteresis", 1.0);
     correction_ = s.get("correction", true);
-    if (!(res_tol_ > 0.0) || !(stall_tol_ >= 0.0) || !(stall_ratio_ > 0.0 && stall_ratio_ <= 1.0) ||
+    if (!(res_tol_ > 0.0) || !(stall_tol_ >= 0.0) || !(stall_step_ >= 0.0) || !(stall_ratio_ > 0.0 && stall_ratio_ <= 1.0) ||
         nopt_.max_iters < 1 || max_cuts_ < 0 || hysteresis_ < 1.0)
       throw std::invalid_argument(
-          "em-exact: need res_tol > 0, stall_tol >= 0, 0 < stall_ratio <= 1, max_iters >= 1, max_cuts >= 0, hysteresis >= 1");
+          "em-exact: need res_tol > 0, stall_tol >= 0, stall_step >= 0, 0 < stall_ratio <= 1, max_iters >= 1, max_cuts >= 0, hysteresis >= 1");
     resolved_ = s.resolved();
     char b[64];
     std::snprintf(b, sizeof b, "%.10g", dt_);
@@ -220,7 +231,9 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
   bool step(State& s, double h, StepReport& rep, std::string* why, bool full_newton = false) {
     Model& sys = *model_;
     rep.chart_switches += sys.rechart(s, hysteresis_);  // between steps only; d, p, v, w unchanged
-    if (h != last_h_) {  // K̄ depends on h
+    // K̄ depends on h. Steps that land on an output time differ from Δt in the last bits (t_out − t): no
+    // reason to throw a factorization away.
+    if (std::abs(h - last_h_) > 1e-8 * h) {
       newton_->invalidate_jacobian();
       if (replay_kbar_) newton_->resume_after_setup(0);  // a saved K̄ for another h is of no use
       replay_kbar_ = false;
@@ -297,24 +310,41 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
       apply_dirichlet(sys.dofs(), J, nullptr);
       if (nopt_.modified && !full_newton) kbar_ = J.values;  // for save()
     };
-    auto hook = [&](int k, const double*, const double*, const double*) -> bool {
+    double first_step = 0.0;  // scaled size of the first correction
+    auto hook = [&](int k, const double*, const double* du, const double*) -> bool {
       const double rk = history.back();
+      double step = 0.0;  // max_i |Δu_k,i| / max(1, |u_n,i|)
+      for (Index i = 0; i < n; ++i) step = std::max(step, std::abs(du[i]) / std::max(1.0, std::abs(un_[i])));
+      if (k == 1) first_step = step;
       if (rk <= res_tol_) return true;
       double prev_best = std::numeric_limits<double>::infinity();
       for (size_t j = 0; j + 1 < history.size(); ++j) prev_best = std::min(prev_best, history[j]);
       if (rk <= stall_tol_ && rk > stall_ratio_ * prev_best) {
-        // Stagnation: at the round-off floor if the iteration matrix was fresh; otherwise refresh it first.
-        if (last_jacobian_iter >= k - 1) return true;
+        // Stagnation at the round-off floor if the iteration matrix was fresh, or if the corrections have
+        // already shrunk by stall_step relative to the first (the iteration converged; what stalls is the
+        // residual's round-off, theory §5); otherwise refresh the matrix first.
+        if (last_jacobian_iter >= k - 1 || step <= stall_step_ * first_step) return true;
         newton.invalidate_jacobian();
       }
       return false;
     };
 
     Eigen::VectorXd u = un_;  // predictor u_{n+1} = u_n (theory §5)
+    if (predictor_ && !full_newton) {  // trapezoidal extrapolation (constructor); directors through their chart
+      for (int i = 0; i < nn_; ++i) {
+        const Index k = DofMap::dof(i, 0);
+        u.segment<3>(k) += h * vn_.segment<3>(3 * i) + (0.5 * h * h) * s.a.segment<3>(k);
+        const Vec3 p = pn_.segment<3>(3 * i) + h * wn_.segment<3>(3 * i);
+        u.segment<2>(k + 3) = chart_coordinates(p.normalized(), charts[static_cast<size_t>(i)]);
+      }
+      for (Index d : sys.dofs().constrained_dofs()) u[d] = un_[d];  // constrained entries stay bitwise u_n
+    }
     sys.prescribed_displacement(t1, u.data());  // prescribed DOFs at g(t_{n+1}) (docs/theory.md §8.6)
     last_u_ = u;
     last_r_.setZero(n);
-    const NewtonSolver::Result r = newton.solve(u.data(), residual, jacobian, nullptr, nullptr, hook);
+    // Scale of the unknowns 1/max(1, |u_n,i|): the solver's round-off guard of the contraction test is relative.
+    uscale_ = (1.0 / un_.array().abs().max(1.0)).matrix();
+    const NewtonSolver::Result r = newton.solve(u.data(), residual, jacobian, nullptr, uscale_.data(), hook);
     if (full_newton) newton_->invalidate_jacobian();
     rep.nonlinear_iterations += r.iterations;
     // A replayed K̄ (restore()) is the uninterrupted run's matrix, not a new setup: not counted.
@@ -380,7 +410,8 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
   double dt_;
   double xi_ = 0.0;
   NewtonOptions nopt_;
-  double res_tol_ = 1e-12, stall_tol_ = 1e-6, stall_ratio_ = 0.5;
+  double res_tol_ = 1e-12, stall_tol_ = 1e-6, stall_ratio_ = 0.5, stall_step_ = 1e-6;
+  bool predictor_ = false;
   int max_cuts_ = 0;
   double hysteresis_ = 1.0;
   bool correction_ = true;
@@ -392,7 +423,7 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
   SparseMatrix M_, K_;
   std::vector<CR9Shell::Mat45> k0_;
   std::vector<double> Un_;
-  Eigen::VectorXd un_, umid_, fint_, r_, last_u_, last_r_;
+  Eigen::VectorXd un_, umid_, fint_, r_, last_u_, last_r_, uscale_;
   Eigen::VectorXd vn_, wn_, pn_, p1_, pmid_, v1_, w1_, mv_, mw_, fd_, g_;
   double work_ = 0.0, prescribed_work_ = 0.0;
   double last_h_ = 0.0;

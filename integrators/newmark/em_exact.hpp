@@ -11,14 +11,17 @@
 //   K + V − W_ext constant (ξ = 0) or decreasing by Σ ξ ΔuᵀGΔu ≥ 0 per step; L exact; J exact without loads.
 //
 // Settings: rho_inf [1] and xi [0] (dissipation; ξ_eff = ξ + (1−ρ∞)/(2(1+ρ∞)), theory §6),
-//   newton full|modified [full], setup_every [20], linear_solver [eigen-ldlt], res_tol [1e-12],
-//   stall_tol [1e-6], stall_ratio [0.5], max_iters [25], max_cuts [0], hysteresis [1],
+//   newton full|modified [full], refresh [0.03 with modified Newton, else 0: refresh K̄ when the observed
+//   contraction exceeds it], setup_every [20; 1e6 when refresh > 0], predictor none|trapezoidal [trapezoidal
+//   with modified Newton, else none], linear_solver [cholmod], res_tol [1e-12], stall_tol [1e-6],
+//   stall_ratio [0.5], stall_step [1e-6], max_iters [25], max_cuts [0], hysteresis [1],
 //   correction [true] (false = the paper's force without the §3 correction: for tests that must fail).
 // Checkpoints (docs/architecture.md "Checkpoints and resume"): save/restore continue bitwise, with modified
 // Newton too; a stop request (SIGINT, --max-wall) is honoured at the next step boundary.
 // Stopping (theory §5): the scaled residual ‖r‖∞ / (‖inertia‖∞ + ‖F*‖∞ + ‖F_ext‖∞) ≤ res_tol, or, once it is
 // below stall_tol, an iteration that does not reduce the best residual by stall_ratio (the round-off floor of
-// the co-rotational force); the last iterate is accepted (docs/theory/exact-energy-momentum.md §5.1).
+// the co-rotational force), accepted with a fresh K̄ or once the corrections have shrunk by stall_step
+// relative to the first; the last iterate is accepted (docs/theory/exact-energy-momentum.md §5, §5.1).
 #pragma once
 
 #include "integrators/integrator.hpp"
