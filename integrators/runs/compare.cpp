@@ -595,7 +595,9 @@ CompareResult run_comparison(const CompareOptions& o) {
         decode_outcome(payload, row.summary, row.energy_error);
         if (log)
           *log << "[" << k + 1 << "/" << runs.size() << "] " << row.run.label << ": " << row.summary.totals.steps << " steps, "
-               << num(row.summary.wall_seconds) << " s, energy error " << num(row.energy_error)
+               << num(row.summary.wall_seconds) << " s, "
+               << (std::isnan(row.energy_error) ? std::string("no energy error after the loads (the run ends while they act)")
+                                                : "energy error after the loads " + num(row.energy_error))
                << (reused ? " (reused: --resume found it finished with the same settings)" : "") << std::endl;
       } catch (const std::exception& e) {
         row.ok = false;
