@@ -11,6 +11,7 @@
 #include "integrators/runs/registry.hpp"
 #include "lib/problem.hpp"
 #include "lib/reactions.hpp"
+#include "tests/support/test_files.hpp"
 
 #include <gtest/gtest.h>
 
@@ -22,14 +23,7 @@
 namespace shelldyn {
 namespace {
 
-std::string error_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const std::exception& e) {
-    return e.what();
-  }
-  return "(no error)";
-}
+using testing::error_of;
 
 // Integrates p with its own integrator block (or `integrator` with its default settings) and calls `each` after
 // every step.
