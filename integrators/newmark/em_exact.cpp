@@ -313,8 +313,8 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
     double first_step = 0.0;  // scaled size of the first correction
     auto hook = [&](int k, const double*, const double* du, const double*) -> bool {
       const double rk = history.back();
-      double step = 0.0;  // max_i |Δu_k,i| / max(1, |u_n,i|)
-      for (Index i = 0; i < n; ++i) step = std::max(step, std::abs(du[i]) / std::max(1.0, std::abs(un_[i])));
+      // max_i |Δu_k,i| / max(1, |u_n,i|), with the solver's scale uscale_ (set below, before solve()).
+      const double step = (Eigen::Map<const Eigen::VectorXd>(du, n).cwiseAbs().array() * uscale_.array()).maxCoeff();
       if (k == 1) first_step = step;
       if (rk <= res_tol_) return true;
       double prev_best = std::numeric_limits<double>::infinity();
