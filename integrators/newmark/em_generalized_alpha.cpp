@@ -82,6 +82,13 @@ class NewmarkFamily final : public Integrator {
     // flying plate at t ≈ 10 s, 70 m from the origin) then lies above any cc_tol that works with u_n.
     e_floor_ = s.get("e_floor", nopt_.modified ? 1e-20 : 0.0);
     if (!(e_floor_ >= 0.0)) throw std::invalid_argument(name_ + ": e_floor must be >= 0");
+    // floor_test (docs/theory.md §6.5): "correction" accepts u_k once its own correction E_k is below the floor,
+    // which bounds the error of u_{k−1}; "estimate" also accepts u_k once the estimated energy of the next
+    // correction is (one iteration fewer where the iteration contracts steadily).
+    const std::string floor_test = s.get("floor_test", std::string(nopt_.modified ? "estimate" : "correction"));
+    if (floor_test != "correction" && floor_test != "estimate")
+      throw std::invalid_argument(name_ + ".floor_test: '" + floor_test + "' (use correction or estimate)");
+    floor_estimate_ = (floor_test == "estimate");
     // CHOLMOD's supernodal Cholesky by default (simplicial LDLᵀ if K̄ is ever indefinite, lib/linear_solver.hpp):
     // with its hidden threads switched off it factorizes the hemisphere's K̄ in ~0.8x and solves in ~0.6x the
     // CPU time of Eigen's simplicial LDLᵀ, and with a kept factorization the solves dominate
@@ -345,11 +352,21 @@ class NewmarkFamily final : public Integrator {
     // Stopping rule of modified Newton (constructor): cc ≤ cc_tol (in NewtonSolver), the energy floor
     // E_k ≤ e_floor·E_sys, or the scaled step test once (round-off reached).
     const double floor = e_floor_ * (energy0_ + std::abs(work_));
+    e_hist_[0] = e_hist_[1] = 0.0;
     NewtonSolver::IterationHook hook;
     if (floor > 0.0 || nopt_.modified)
       hook = [this, floor, n, &newton](int, const double*, const double* du, const double* f) {
         const Eigen::Map<const Eigen::VectorXd> d(du, n), r(f, n);
-        if (floor > 0.0 && std::abs(d.dot(r)) <= floor) return true;  // E_k = |Δu_k·P̄(u_{k−1})| (eq. 39)
+        const double Ek = std::abs(d.dot(r));  // E_k = |Δu_k·P̄(u_{k−1})| (eq. 39)
+        if (floor > 0.0 && Ek <= floor) return true;
+        // floor_test = estimate (docs/theory.md §6.5): E_k measures the error of u_{k−1}; that of u_k is about
+        // the next correction's energy θ_E E_k, θ_E the observed energy contraction (the larger of the last two
+        // ratios: the first iteration from the predictor contracts faster than the rest), with a margin of 10.
+        if (floor_estimate_ && floor > 0.0 && e_hist_[1] > 0.0 &&
+            10.0 * Ek * std::max(Ek / e_hist_[0], e_hist_[0] / e_hist_[1]) <= floor)
+          return true;
+        e_hist_[1] = e_hist_[0];
+        e_hist_[0] = Ek;
         // Scaled step test |Δu_i| ≤ step_tol max(1, |u_n,i|), met once (modified Newton, see the constructor).
         if (!newton.options().modified || step_refresh_) return false;
         return (d.array().abs() * uscale_.array()).maxCoeff() <= step_tol_;
@@ -415,6 +432,8 @@ class NewmarkFamily final : public Integrator {
   double last_h_ = 0.0;
   long steps_ = 0;
   std::vector<double> kbar_;   // the modified solver's last K̄ (checkpoints)
+  double e_hist_[2] = {0.0, 0.0};  // E_{k−1}, E_{k−2} of the current step (floor_test = estimate)
+  bool floor_estimate_ = false;
   bool replay_kbar_ = false;   // restore(): the next setup of the modified solver uses kbar_
 };
 

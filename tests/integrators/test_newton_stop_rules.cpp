@@ -1,11 +1,13 @@
 // Stopping rules of modified Newton (docs/theory.md §6.5) and NewtonOptions::skip_final_residual.
 #include "integrators/nonlinear/newton_solver.hpp"
 #include "integrators/runs/registry.hpp"
+#include "lib/problem.hpp"
 
 #include "dynamics_fixtures.hpp"
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <memory>
@@ -134,6 +136,59 @@ TEST(NewtonStopRules, ModifiedNewtonEndsAStalledIterationWithoutRefreshing) {
   // All three end at the same solution to far below the discretisation error.
   EXPECT_LT((floor.u - step.u).norm(), 1e-9 * step.u.norm());
   EXPECT_LT((kinsol.u - step.u).norm(), 1e-9 * step.u.norm());
+}
+
+// floor_test = estimate, the modified-Newton default (docs/theory.md §6.5), against the plain floor test and
+// against iterating to round-off, on the flying plate's first 0.4 s (apps/cases/flying-plate.yaml, loads
+// acting): fewer iterations, the same solution and energy balance to far below the discretisation error.
+TEST(NewtonStopRules, EstimatedFloorTestSavesIterationsAtTheSameSolution) {
+  struct Totals {
+    StepReport rep;
+    Eigen::VectorXd u;
+    std::vector<double> balance;  // K + V − W_ext per step
+    double energy = 0.0;          // largest K + V
+  };
+  const double dt = 1e-3;
+  const int steps = 400;
+  auto run = [&](std::vector<std::pair<std::string, std::string>> settings) {
+    Problem p = load_problem(std::string(SHELLDYN_SOURCE_DIR) + "/apps/cases/flying-plate.yaml");
+    State s = p.initial_state();
+    settings.push_back({"newton", "modified"});
+    IntegratorSettings is("em-galpha", settings);
+    auto integ = make_integrator(is, dt);
+    integ->initialize(*p.model, s);
+    Totals t;
+    for (int k = 1; k <= steps; ++k) {
+      t.rep.accumulate(integ->advance(*p.model, s, k * dt));
+      const Invariants inv = p.model->invariants(s);
+      t.balance.push_back(inv.kinetic + inv.strain - integ->external_work());
+      t.energy = std::max(t.energy, inv.kinetic + inv.strain);
+    }
+    t.u = s.u;
+    return t;
+  };
+  const Totals ref = run({{"e_floor", "1e-30"}, {"cc_tol", "1e-30"}});  // iterated to round-off
+  const Totals corr = run({{"floor_test", "correction"}});
+  const Totals est = run({});  // default: floor_test = estimate
+  auto balance_gap = [&](const Totals& t) {  // largest difference of K + V − W from the round-off run's, / (K + V)
+    double gap = 0.0;
+    for (size_t k = 0; k < t.balance.size(); ++k) gap = std::max(gap, std::abs(t.balance[k] - ref.balance[k]));
+    return gap / ref.energy;
+  };
+  std::printf("[ info ] 400 steps: iterations round-off %ld, correction %ld, estimate %ld; |u - u_ref|/|u_ref| %.2e %.2e; "
+              "K+V-W gap %.2e %.2e (the scheme's own max |K+V-W|/(K+V) %.2e)\n",
+              ref.rep.nonlinear_iterations, corr.rep.nonlinear_iterations, est.rep.nonlinear_iterations,
+              (corr.u - ref.u).norm() / ref.u.norm(), (est.u - ref.u).norm() / ref.u.norm(), balance_gap(corr),
+              balance_gap(est), std::abs(*std::max_element(ref.balance.begin(), ref.balance.end(),
+                                                          [](double a, double b) { return std::abs(a) < std::abs(b); })) / ref.energy);
+  for (const Totals* t : {&corr, &est}) {
+    EXPECT_EQ(t->rep.steps, steps);
+    EXPECT_EQ(t->rep.rejected_steps, 0);
+    EXPECT_LT((t->u - ref.u).norm(), 1e-10 * ref.u.norm());
+    EXPECT_LT(balance_gap(*t), 3e-12);  // measured 4.3e-14 (correction) and 9.4e-13 (estimate)
+  }
+  // Measured 1 404 against 1 698 iterations (17 % fewer).
+  EXPECT_LT(est.rep.nonlinear_iterations, 0.9 * corr.rep.nonlinear_iterations);
 }
 
 }  // namespace
