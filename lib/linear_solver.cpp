@@ -7,7 +7,7 @@
 
 #include <Eigen/SparseCholesky>
 #include <cholmod.h>
-#include <dmumps_c.h>  // Debian libmumps-seq-dev (sequential MUMPS 5.5, linked against libdmumps_seq)
+#include <dmumps_c.h>  // Debian libmumps-seq-dev (sequential MUMPS 5.5; libdmumps_seq is dlopen'ed, see MumpsSolver)
 #include <klu.h>
 
 #include <dlfcn.h>
@@ -441,9 +441,34 @@ class KluSolver final : public LinearSolver {
 // Threads: Debian's sequential MUMPS has no OpenMP; its dense kernels go through the system BLAS, limited
 // to one thread like CHOLMOD's (limit_blas_threads above).
 // ------------------------------------------------------------------------------------------------
+//
+// Loaded at run time (dlopen, RTLD_LOCAL) rather than linked: Debian's sequential libraries carry their own
+// MPI stubs and export the C symbols MPI_Init, MPI_Comm_rank, MPI_Finalize and MPI_Wtime. Linked into an
+// executable that also uses Open MPI (the MPI sweep executor, integrators/runs/mpi_executor.hpp), they can
+// come first in the global symbol lookup and turn the real MPI_Init into a stub. Loaded locally, they are
+// seen by nobody but the solver (MUMPS calls only its Fortran stubs mpi_*_, which Open MPI's C library
+// does not define). docs/dependencies.md §2.4.
+using DmumpsC = void (*)(DMUMPS_STRUC_C*);
+DmumpsC dmumps_entry() {
+  static const DmumpsC entry = [] {
+    void* lib = dlopen(SHELLDYN_DMUMPS_SEQ_LIBRARY, RTLD_NOW | RTLD_LOCAL);
+    if (lib == nullptr) {
+      const char* why = dlerror();
+      throw std::runtime_error(std::string("mumps: cannot load the sequential MUMPS library ") +
+                               SHELLDYN_DMUMPS_SEQ_LIBRARY + " (" + (why ? why : "unknown error") +
+                               "); install libmumps-seq-dev (scripts/install-deps.sh) or use linear_solver=cholmod");
+    }
+    void* f = dlsym(lib, "dmumps_c");
+    if (f == nullptr)
+      throw std::runtime_error(std::string("mumps: ") + SHELLDYN_DMUMPS_SEQ_LIBRARY + " has no dmumps_c");
+    return reinterpret_cast<DmumpsC>(f);
+  }();
+  return entry;
+}
+
 class MumpsSolver final : public LinearSolver {
  public:
-  MumpsSolver() {
+  MumpsSolver() : dmumps_c(dmumps_entry()) {
     limit_blas_threads();
     id_.comm_fortran = kUseCommWorld;  // the sequential library's stub communicator
     id_.par = 1;                       // the host works (the only process)
@@ -591,6 +616,7 @@ class MumpsSolver final : public LinearSolver {
     return os.str();
   }
 
+  DmumpsC dmumps_c;
   mutable DMUMPS_STRUC_C id_{};
   bool alive_ = false;
   std::vector<MUMPS_INT> irn_, jcn_;
