@@ -9,14 +9,27 @@
 // The "factorize" benchmark times the numeric factorization on a kept analysis (what a Newton setup
 // costs); the analysis is timed separately; values are perturbed between iterations so KLU's
 // refactor path is exercised as in a Newton loop.
+//
+// The effective tangent of a case instead of the synthetic pattern (docs/dependencies.md §5.2):
+//   OPENBLAS_NUM_THREADS=1 ./bench_linear_solvers --case apps/cases/pinched-hemisphere.yaml [--case ...]
+// builds K̄ = M/(β Δt²) + (1 − α_f) K at the case's initial state and time step Δt, with β = 1/4 and
+// α_f = 1/2 (the trapezoidal member of the Newmark family; em-galpha's coefficients differ with ρ∞, which
+// changes the values, not the pattern or the fill), and benchmarks every back-end on it. All other
+// arguments go to Google Benchmark (--benchmark_filter=..., --benchmark_repetitions=..., see --help). The CPU
+// column of these benchmarks is the whole process's CPU time, so a back-end's helper threads would show.
 #include "lib/linear_solver.hpp"
+#include "lib/problem.hpp"
 
 #include <benchmark/benchmark.h>
 
 #include <Eigen/Sparse>
 
+#include <cstdio>
+#include <cstring>
+#include <iostream>
 #include <memory>
 #include <random>
+#include <string>
 #include <vector>
 
 namespace {
@@ -110,10 +123,99 @@ void Args(benchmark::internal::Benchmark* b) {
   b->ArgNames({"solver", "ne"})->Unit(benchmark::kMillisecond);
 }
 
-BENCHMARK(Analyze)->Apply(Args);
-BENCHMARK(Factorize)->Apply(Args);
-BENCHMARK(Solve)->Apply(Args);
+// ---- K̄ of a case file (--case) ------------------------------------------------------------------
+shelldyn::SparseMatrix case_kbar(const std::string& path) {
+  shelldyn::Problem p = shelldyn::load_problem(path);
+  const shelldyn::Model& m = *p.model;
+  const shelldyn::State s = p.initial_state();
+  shelldyn::SparseMatrix K = m.make_matrix(), M = m.make_matrix();
+  m.internal(s.u, s.charts, nullptr, &K);
+  m.mass(s.u, s.charts, M);
+  const double dt = p.spec.time.dt, beta = 0.25, alpha_f = 0.5;
+  for (size_t k = 0; k < K.values.size(); ++k) K.values[k] = M.values[k] / (beta * dt * dt) + (1 - alpha_f) * K.values[k];
+  return K;
+}
+
+void register_case(const std::string& path) {
+  auto A = std::make_shared<shelldyn::SparseMatrix>(case_kbar(path));
+  std::string stem = path.substr(path.find_last_of('/') + 1);
+  stem = stem.substr(0, stem.find('.'));
+  const std::string label = ", n = " + std::to_string(A->pattern->n) + ", nnz = " + std::to_string(A->pattern->nnz());
+  for (const auto& name : names()) {
+    benchmark::RegisterBenchmark(("CaseAnalyze/" + stem + "/" + name).c_str(), [=](benchmark::State& st) {
+      for (auto _ : st) {
+        auto s = shelldyn::make_linear_solver(name);
+        s->analyze(A->view());
+        benchmark::DoNotOptimize(s.get());
+      }
+      st.SetLabel(name + label);
+    })->Unit(benchmark::kMillisecond)->MeasureProcessCPUTime();
+    benchmark::RegisterBenchmark(("CaseFactorize/" + stem + "/" + name).c_str(), [=](benchmark::State& st) {
+      shelldyn::SparseMatrix B = *A;
+      auto s = shelldyn::make_linear_solver(name);
+      s->analyze(B.view());
+      s->factorize(B.view());
+      int k = 0;
+      for (auto _ : st) {
+        st.PauseTiming();
+        const double f = 1.0 + 1e-3 * ((++k % 7) - 3);  // new values, same pattern
+        for (size_t p = 0; p < B.values.size(); ++p) B.values[p] = A->values[p] * f;
+        st.ResumeTiming();
+        s->factorize(B.view());
+      }
+      st.SetLabel(name + label);
+      st.counters["negative_pivots"] = static_cast<double>(s->negative_pivots());
+    })->Unit(benchmark::kMillisecond)->MeasureProcessCPUTime();
+    benchmark::RegisterBenchmark(("CaseSolve/" + stem + "/" + name).c_str(), [=](benchmark::State& st) {
+      auto s = shelldyn::make_linear_solver(name);
+      s->factorize(A->view());
+      std::vector<double> b(A->pattern->n, 1.0), x(A->pattern->n);
+      for (auto _ : st) {
+        s->solve(b.data(), x.data());
+        benchmark::DoNotOptimize(x.data());
+      }
+      st.SetLabel(name + label);
+    })->Unit(benchmark::kMillisecond)->MeasureProcessCPUTime();
+  }
+}
 
 }  // namespace
 
-BENCHMARK_MAIN();
+int main(int argc, char** argv) {
+  std::vector<char*> rest{argv[0]};
+  std::vector<std::string> cases;
+  for (int i = 1; i < argc; ++i) {
+    if (std::strcmp(argv[i], "--case") == 0) {
+      if (i + 1 >= argc) {
+        std::cerr << "bench_linear_solvers: --case needs a case file (e.g. apps/cases/flying-plate.yaml)\n";
+        return 2;
+      }
+      cases.emplace_back(argv[++i]);
+    } else {
+      if (std::strcmp(argv[i], "--help") == 0 || std::strcmp(argv[i], "-h") == 0)
+        std::puts("bench_linear_solvers [--case CASE.yaml]... [Google Benchmark options]\n"
+                  "  without --case: synthetic 9-node-shell patterns, ne = 8 and 16 (5445 unknowns)\n"
+                  "  --case FILE     K̄ = M/(Δt²/4) + K/2 of the case at its initial state and time step;\n"
+                  "                  repeatable; the synthetic benchmarks are then left out\n"
+                  "  Google Benchmark's own options follow.\n");
+      rest.push_back(argv[i]);
+    }
+  }
+  try {
+    for (const auto& c : cases) register_case(c);
+  } catch (const std::exception& e) {
+    std::cerr << "bench_linear_solvers: " << e.what() << "\n";
+    return 1;
+  }
+  if (cases.empty()) {
+    benchmark::RegisterBenchmark("Analyze", Analyze)->Apply(Args);
+    benchmark::RegisterBenchmark("Factorize", Factorize)->Apply(Args);
+    benchmark::RegisterBenchmark("Solve", Solve)->Apply(Args);
+  }
+  int rargc = static_cast<int>(rest.size());
+  benchmark::Initialize(&rargc, rest.data());
+  if (benchmark::ReportUnrecognizedArguments(rargc, rest.data())) return 1;
+  benchmark::RunSpecifiedBenchmarks();
+  benchmark::Shutdown();
+  return 0;
+}

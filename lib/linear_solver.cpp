@@ -7,6 +7,7 @@
 
 #include <Eigen/SparseCholesky>
 #include <cholmod.h>
+#include <dmumps_c.h>  // Debian libmumps-seq-dev (sequential MUMPS 5.5; libdmumps_seq is dlopen'ed, see MumpsSolver)
 #include <klu.h>
 
 #include <dlfcn.h>
@@ -69,16 +70,15 @@ void check_same_shape(const CscView& A, Index n, Index nnz, const std::string& w
 //    overrides omp_set_num_threads(); on a 2-core machine those threads spin and burn CPU. We call
 //    CHOLMOD with OpenMP's max-active-levels set to 0 (single_threaded below), so they run on one thread.
 //  - OpenBLAS (pthread build) starts one thread per core for the dense supernode kernels; on matrices of
-//    a few thousand unknowns they cost more than they save. openblas_set_num_threads(1) is called once
-//    if the symbol is present (looked up at run time, so a reference BLAS works as well).
+//    a few thousand unknowns they cost more than they save. openblas_set_num_threads(1) is called if the
+//    symbol is present (looked up at run time, so a reference BLAS works as well). The pool's threads are
+//    created when OpenBLAS is loaded and then sleep: they appear in /proc/self/task but burn no CPU.
+//    Called by every CHOLMOD and MUMPS constructor (not once per process), so that a solver made after
+//    someone raised the BLAS thread count still runs its kernels on one thread.
 void limit_blas_threads() {
-  static const bool once = [] {
-    using SetThreads = void (*)(int);
-    if (void* f = dlsym(RTLD_DEFAULT, "openblas_set_num_threads"))
-      reinterpret_cast<SetThreads>(f)(1);
-    return true;
-  }();
-  (void)once;
+  using SetThreads = void (*)(int);
+  static const auto set = reinterpret_cast<SetThreads>(dlsym(RTLD_DEFAULT, "openblas_set_num_threads"));
+  if (set) set(1);
 }
 
 template <class F>
@@ -431,6 +431,203 @@ class KluSolver final : public LinearSolver {
   bool factorized_ = false;
 };
 
+
+// ------------------------------------------------------------------------------------------------
+// MUMPS (sequential, dmumps_c): multifrontal LDLᵀ with threshold pivoting (1×1 and 2×2 pivots) for
+// general symmetric matrices, SYM = 2 (docs/dependencies.md §5.2). The centralized assembled input
+// holds one triangle (row ≤ column) in 1-based coordinates; the index arrays are built once per pattern
+// by analyze(), factorize() only gathers the values through pos_. Analysis uses the pattern only
+// (ICNTL(6) = 0, ICNTL(12) = 1), so one analysis stays valid for any values on that pattern.
+// Threads: Debian's sequential MUMPS has no OpenMP; its dense kernels go through the system BLAS, limited
+// to one thread like CHOLMOD's (limit_blas_threads above).
+// ------------------------------------------------------------------------------------------------
+//
+// Loaded at run time (dlopen, RTLD_LOCAL) rather than linked: Debian's sequential libraries carry their own
+// MPI stubs and export the C symbols MPI_Init, MPI_Comm_rank, MPI_Finalize and MPI_Wtime. Linked into an
+// executable that also uses Open MPI (the MPI sweep executor, integrators/runs/mpi_executor.hpp), they can
+// come first in the global symbol lookup and turn the real MPI_Init into a stub. Loaded locally, they are
+// seen by nobody but the solver (MUMPS calls only its Fortran stubs mpi_*_, which Open MPI's C library
+// does not define). docs/dependencies.md §2.4.
+using DmumpsC = void (*)(DMUMPS_STRUC_C*);
+DmumpsC dmumps_entry() {
+  static const DmumpsC entry = [] {
+    void* lib = dlopen(SHELLDYN_DMUMPS_SEQ_LIBRARY, RTLD_NOW | RTLD_LOCAL);
+    if (lib == nullptr) {
+      const char* why = dlerror();
+      throw std::runtime_error(std::string("mumps: cannot load the sequential MUMPS library ") +
+                               SHELLDYN_DMUMPS_SEQ_LIBRARY + " (" + (why ? why : "unknown error") +
+                               "); install libmumps-seq-dev (scripts/install-deps.sh) or use linear_solver=cholmod");
+    }
+    void* f = dlsym(lib, "dmumps_c");
+    if (f == nullptr)
+      throw std::runtime_error(std::string("mumps: ") + SHELLDYN_DMUMPS_SEQ_LIBRARY + " has no dmumps_c");
+    return reinterpret_cast<DmumpsC>(f);
+  }();
+  return entry;
+}
+
+class MumpsSolver final : public LinearSolver {
+ public:
+  MumpsSolver() : dmumps_c(dmumps_entry()) {
+    limit_blas_threads();
+    id_.comm_fortran = kUseCommWorld;  // the sequential library's stub communicator
+    id_.par = 1;                       // the host works (the only process)
+    id_.sym = 2;                       // general symmetric: indefinite matrices allowed
+    id_.job = -1;                      // initialise the instance
+    dmumps_c(&id_);
+    if (id_.infog[0] < 0)
+      throw std::runtime_error("mumps: initialisation failed (INFOG(1) = " + std::to_string(id_.infog[0]) + ")");
+    alive_ = true;
+    // Silence: no error, diagnostic or global-information output, print level 0 (ICNTL(1..4)).
+    icntl(1) = -1;
+    icntl(2) = -1;
+    icntl(3) = -1;
+    icntl(4) = 0;
+    icntl(6) = 0;   // no value-based column permutation at analysis: the analysis depends on the pattern only
+    icntl(7) = kOrdering;
+    icntl(12) = 1;  // usual ordering on the pattern (no value-based compression of 2×2 pivot candidates)
+    icntl(24) = 1;  // null pivot detection: a singular matrix is reported with its column (PIVNUL_LIST)
+  }
+  ~MumpsSolver() override {
+    if (alive_) {
+      id_.job = -2;  // free everything MUMPS allocated
+      dmumps_c(&id_);
+    }
+  }
+  MumpsSolver(const MumpsSolver&) = delete;
+  MumpsSolver& operator=(const MumpsSolver&) = delete;
+
+  std::string name() const override { return "mumps"; }
+  bool factorized() const override { return factorized_; }
+
+  void analyze(const CscView& A) override {
+    profile::Scope prof(profile::Section::analyze);
+    check_csc_pattern(A, "mumps");
+    if (A.n > static_cast<Index>(std::numeric_limits<MUMPS_INT>::max()))
+      throw std::invalid_argument("mumps: n = " + std::to_string(A.n) +
+                                  " exceeds the 32-bit index range of Debian's MUMPS build; use cholmod");
+    const auto t0 = Clock::now();
+    factorized_ = false;
+    analysed_ = false;
+    // One triangle of the full storage, 1-based, once per pattern.
+    irn_.clear();
+    jcn_.clear();
+    pos_.clear();
+    for (Index j = 0; j < A.n; ++j)
+      for (Index p = A.colptr[j]; p < A.colptr[j + 1]; ++p)
+        if (A.rowind[p] <= j) {
+          irn_.push_back(static_cast<MUMPS_INT>(A.rowind[p] + 1));
+          jcn_.push_back(static_cast<MUMPS_INT>(j + 1));
+          pos_.push_back(p);
+        }
+    a_.assign(pos_.size(), 0.0);
+    rhs_.assign(static_cast<size_t>(A.n), 0.0);
+    n_ = A.n;
+    nnz_ = A.nnz();
+    point_arrays();
+    id_.job = 1;
+    dmumps_c(&id_);
+    if (id_.infog[0] < 0) throw std::runtime_error("mumps: analysis failed: " + describe_error());
+    analysed_ = true;
+    ++stats_.analyses;
+    stats_.analyze_s += seconds_since(t0);
+  }
+
+  void factorize(const CscView& A) override {
+    profile::Scope prof(profile::Section::factorize);
+    if (!analysed_) analyze(A);
+    check_same_shape(A, n_, nnz_, "mumps");
+    check_values(A, "mumps");
+    factorized_ = false;
+    const auto t0 = Clock::now();
+    for (size_t k = 0; k < pos_.size(); ++k) a_[k] = A.values[pos_[k]];
+    point_arrays();
+    id_.job = 2;
+    dmumps_c(&id_);
+    // Workspace estimates from the analysis can be too small once pivots are delayed (INFO(1) = -8/-9):
+    // grow the relaxation ICNTL(14) and factorize again (MUMPS user guide, "Error diagnostics").
+    for (int attempt = 0; attempt < 4 && (id_.infog[0] == -8 || id_.infog[0] == -9); ++attempt) {
+      icntl(14) = 2 * std::max(icntl(14), 20);
+      dmumps_c(&id_);
+    }
+    stats_.factorize_s += seconds_since(t0);
+    if (id_.infog[0] < 0) {
+      if (id_.infog[0] == -10)
+        throw std::runtime_error("mumps: matrix is numerically singular (" + std::to_string(id_.info[1]) +
+                                 " pivots eliminated before the breakdown)");
+      throw std::runtime_error("mumps: factorization failed: " + describe_error());
+    }
+    if (id_.infog[27] > 0) {  // INFOG(28): null pivots found by ICNTL(24); PIVNUL_LIST holds their rows
+      std::ostringstream os;
+      os << "mumps: zero pivot at column " << (id_.pivnul_list ? id_.pivnul_list[0] - 1 : -1)
+         << " (matrix singular to working precision; " << id_.infog[27] << " null pivot"
+         << (id_.infog[27] > 1 ? "s" : "") << ")";
+      throw std::runtime_error(os.str());
+    }
+    factorized_ = true;
+    ++stats_.factorizations;
+  }
+
+  // INFOG(12): number of negative pivots of the LDLᵀ factorization (2×2 pivots counted by their
+  // eigenvalues), i.e. the inertia by Sylvester's law.
+  long negative_pivots() const override {
+    if (!factorized_) throw std::logic_error("mumps: negative_pivots() called without a valid factorization");
+    return static_cast<long>(id_.infog[11]);
+  }
+
+  void solve(const double* b, double* x) const override {
+    profile::Scope prof(profile::Section::solve);
+    if (!factorized_) throw std::logic_error("mumps: solve() called without a valid factorization");
+    const auto t0 = Clock::now();
+    std::memcpy(rhs_.data(), b, sizeof(double) * static_cast<size_t>(n_));  // alias-safe: rhs_ is separate
+    id_.rhs = rhs_.data();
+    id_.nrhs = 1;
+    id_.lrhs = static_cast<MUMPS_INT>(n_);
+    id_.job = 3;
+    dmumps_c(&id_);
+    if (id_.infog[0] < 0) throw std::runtime_error("mumps: solve failed: " + describe_error());
+    std::memcpy(x, rhs_.data(), sizeof(double) * static_cast<size_t>(n_));
+    ++stats_.solves;
+    stats_.solve_s += seconds_since(t0);
+  }
+
+ private:
+  static constexpr MUMPS_INT kUseCommWorld = -987654;  // MUMPS' "MPI_COMM_WORLD" for the C interface
+  static constexpr MUMPS_INT kOrdering = 0;            // ICNTL(7): 0 = AMD, as for the other back-ends
+
+  MUMPS_INT& icntl(int k) { return id_.icntl[k - 1]; }  // 1-based, as in the MUMPS user guide
+  void point_arrays() const {
+    id_.n = static_cast<MUMPS_INT>(n_);
+    id_.nnz = static_cast<MUMPS_INT8>(pos_.size());
+    id_.irn = const_cast<MUMPS_INT*>(irn_.data());  // read only by MUMPS
+    id_.jcn = const_cast<MUMPS_INT*>(jcn_.data());
+    id_.a = const_cast<double*>(a_.data());
+  }
+  std::string describe_error() const {
+    std::ostringstream os;
+    os << "INFOG(1) = " << id_.infog[0] << ", INFOG(2) = " << id_.infog[1];
+    switch (id_.infog[0]) {
+      case -5: case -7: case -13: os << " (out of memory)"; break;
+      case -8: case -9: case -14: case -15: case -17: case -20: os << " (work array too small)"; break;
+      case -10: os << " (numerically singular)"; break;
+      case -16: os << " (bad n)"; break;
+      default: break;
+    }
+    return os.str();
+  }
+
+  DmumpsC dmumps_c;
+  mutable DMUMPS_STRUC_C id_{};
+  bool alive_ = false;
+  std::vector<MUMPS_INT> irn_, jcn_;
+  std::vector<Index> pos_;  // CSC position of each triangle entry
+  std::vector<double> a_;
+  mutable std::vector<double> rhs_;
+  Index n_ = 0, nnz_ = 0;
+  bool analysed_ = false;
+  bool factorized_ = false;
+};
+
 }  // namespace
 
 void check_csc_pattern(const CscView& A, const std::string& who) {
@@ -468,12 +665,13 @@ void check_csc_pattern(const CscView& A, const std::string& who) {
   }
 }
 
-std::vector<std::string> linear_solver_names() { return {"cholmod", "eigen-ldlt", "klu"}; }
+std::vector<std::string> linear_solver_names() { return {"cholmod", "eigen-ldlt", "klu", "mumps"}; }
 
 std::unique_ptr<LinearSolver> make_linear_solver(const std::string& name) {
   if (name == "cholmod") return std::make_unique<CholmodSolver>();
   if (name == "eigen-ldlt") return std::make_unique<EigenLdltSolver>();
   if (name == "klu") return std::make_unique<KluSolver>();
+  if (name == "mumps") return std::make_unique<MumpsSolver>();
   std::string valid;
   for (const auto& n : linear_solver_names()) valid += (valid.empty() ? "" : ", ") + n;
   throw std::invalid_argument("unknown linear solver '" + name + "'; valid names: " + valid);

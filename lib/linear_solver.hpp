@@ -4,9 +4,10 @@
 //
 // Input contract (lib/sparse_matrix.hpp): square CSC with 64-bit indices, FULL storage (both
 // triangles), row indices sorted within each column, no duplicates. Each back-end reads what it
-// needs directly from that storage, without copying the pattern. "cholmod" and "eigen-ldlt" read
-// one triangle and therefore assume symmetric values; "klu" factors the full storage and also
-// works for non-symmetric matrices (e.g. IDA/ARKODE iteration matrices of first-order systems).
+// needs directly from that storage ("mumps" keeps its own 1-based copy of one triangle's indices).
+// "cholmod", "eigen-ldlt" and "mumps" read one triangle and therefore assume symmetric values;
+// "klu" factors the full storage and also works for non-symmetric matrices (e.g. IDA/ARKODE
+// iteration matrices of first-order systems).
 //   - "cholmod":    CHOLMOD (cholmod_l_*), upper triangle (stype = +1), AMD ordering, supernodal LLᵀ.
 //                   If the matrix is not positive definite (CHOLMOD_NOT_POSDEF), the solver switches
 //                   PERMANENTLY to simplicial LDLᵀ (re-analysis once; visible as an extra count in
@@ -23,6 +24,12 @@
 //                   estimate klu_l_rcond drops below eps^(2/3) a fresh klu_l_factor re-pivots
 //                   (same threshold as SUNDIALS' own KLU module, docs/dependencies.md §3.2). Handles indefinite
 //                   matrices; slower than the other two on shell patterns.
+//   - "mumps":      sequential MUMPS 5.5 (dmumps_c, loaded with dlopen: docs/dependencies.md §2.4), SYM = 2:
+//                   multifrontal LDLᵀ with threshold pivoting (1×1 and 2×2), so indefinite matrices are
+//                   factorized stably; upper triangle in 1-based coordinates built once per pattern, AMD
+//                   ordering, pattern-only analysis. Inertia from INFOG(12); null-pivot detection
+//                   (ICNTL(24)) names the column of a singular matrix. No output (ICNTL(1..4)), BLAS on one
+//                   thread. Slower than "cholmod" on the project's K̄ (docs/dependencies.md §5.2).
 //
 // Errors: bad input (wrong size, unsorted pattern, non-finite values, pattern different from the
 // analysed one) -> std::invalid_argument; singular / not positive definite / breakdown ->
@@ -45,7 +52,7 @@ class LinearSolver {
  public:
   virtual ~LinearSolver() = default;
 
-  // Registered name ("cholmod", "eigen-ldlt", "klu").
+  // Registered name ("cholmod", "eigen-ldlt", "klu", "mumps").
   virtual std::string name() const = 0;
 
   // Fill-reducing ordering + symbolic analysis. Call once per pattern; calling it again with a
@@ -81,7 +88,7 @@ class LinearSolver {
   mutable Stats stats_;
 };
 
-// "cholmod" | "eigen-ldlt" | "klu"; anything else throws std::invalid_argument listing valid names.
+// "cholmod" | "eigen-ldlt" | "klu" | "mumps"; anything else throws std::invalid_argument listing valid names.
 std::unique_ptr<LinearSolver> make_linear_solver(const std::string& name);
 std::vector<std::string> linear_solver_names();
 

@@ -9,6 +9,7 @@ PACKAGES=(
   cmake g++ make                       # toolchain
   libsundials-dev                      # SUNDIALS 6.4.1: KINSOL, IDA, ARKODE (+ KLU linear solver)
   libsuitesparse-dev                   # KLU, CHOLMOD
+  libmumps-seq-dev                     # sequential MUMPS: the "mumps" linear solver (lib/linear_solver.cpp)
   libopenblas0-pthread                 # fast BLAS for CHOLMOD's supernodal factorization
   libeigen3-dev                        # Eigen 3.4
   libyaml-cpp-dev libcli11-dev         # case files, command line

@@ -40,7 +40,7 @@ class ArkodeIntegrator final : public SundialsBaseline {
       const auto names = linear_solver_names();
       if (std::find(names.begin(), names.end(), linear_solver_) == names.end())
         throw std::invalid_argument(name_ + ": unknown linear_solver '" + linear_solver_ +
-                                    "' (M + gamma^2 K is symmetric: eigen-ldlt, cholmod or klu)");
+                                    "' (M + gamma^2 K is symmetric: eigen-ldlt, cholmod, mumps or klu)");
       if (lsetup_frequency_ < 0) throw std::invalid_argument(name_ + ": lsetup_frequency must be >= 0 (0 = ARKODE default 20)");
       if (max_nonlin_ < 1) throw std::invalid_argument(name_ + ": max_nonlin_iters must be >= 1");
     }

@@ -16,7 +16,7 @@
 //
 //     J ≈ [[0, I, 0, 0]; [−M⁻¹K, −M⁻¹C, 0, 0]; [0, 0, 0, 0]; [0, 0, 0, 0]]   (y = [q; v; w; d])
 //
-// by the Schur complement (symmetric, factorized with linear_solver: eigen-ldlt|cholmod|klu):
+// by the Schur complement (symmetric, factorized with linear_solver: eigen-ldlt|cholmod|mumps|klu):
 //
 //     (M + γC + γ²K) x_q = M (b_q + γ b_v) + γ C b_q,   x_v = (x_q − b_q)/γ,   x_w = b_w,   x_d = b_d,
 //

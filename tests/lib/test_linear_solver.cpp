@@ -6,8 +6,10 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/Dense>
 #include <Eigen/Sparse>
 #include <dirent.h>
+#include <dlfcn.h>
 #include <omp.h>
 
 #include <algorithm>
@@ -75,7 +77,7 @@ std::vector<double> random_vector(Index n, unsigned seed) {
 
 TEST(LinearSolver, FactoryListsNamesAndRejectsUnknown) {
   const auto names = linear_solver_names();
-  ASSERT_EQ(names.size(), 3u);
+  ASSERT_EQ(names.size(), 4u);
   for (const auto& n : names) EXPECT_EQ(make_linear_solver(n)->name(), n);
   try {
     make_linear_solver("umfpack");
@@ -177,6 +179,74 @@ TEST(LinearSolver, CholmodFallsBackToLdltOnIndefiniteMatrix) {
   }
 }
 
+// Indefinite matrix with a known spectrum: every back-end solves it, and the inertia reported by the
+// LDLᵀ back-ends (negative_pivots(), Sylvester's law) equals the number of negative eigenvalues computed
+// densely. The shift -0.5 puts a sizeable fraction of the 125 eigenvalues below zero, none near it.
+TEST(LinearSolver, IndefiniteMatrixSolvedAndInertiaMatchesSpectrum) {
+  const SparseMatrix A = shell_like_matrix(2, 14, -0.5);
+  const Index n = A.pattern->n;
+  Eigen::MatrixXd dense = Eigen::MatrixXd::Zero(n, n);
+  for (Index j = 0; j < n; ++j)
+    for (Index p = A.pattern->colptr[j]; p < A.pattern->colptr[j + 1]; ++p) dense(A.pattern->rowind[p], j) = A.values[p];
+  const Eigen::VectorXd lambda = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(dense).eigenvalues();
+  const long negative = static_cast<long>((lambda.array() < 0.0).count());
+  ASSERT_GT(negative, 0);
+  ASSERT_LT(negative, n);
+  ASSERT_GT(lambda.cwiseAbs().minCoeff(), 1e-6);  // no eigenvalue near zero: the count is well defined
+  const auto b = random_vector(n, 15);
+  for (const auto& name : linear_solver_names()) {
+    auto s = make_linear_solver(name);
+    s->factorize(A.view());
+    std::vector<double> x(b.size());
+    s->solve(b.data(), x.data());
+    EXPECT_LT(relative_residual(A.view(), x, b), 1e-9) << name;
+    if (name == "klu")
+      EXPECT_EQ(s->negative_pivots(), -1) << name;  // LU pivots are no inertia
+    else
+      EXPECT_EQ(s->negative_pivots(), negative) << name;
+  }
+}
+
+// Refactorization with new values on the kept analysis: the second solution must be that of the new
+// matrix (not of the first one), for every back-end.
+TEST(LinearSolver, RefactorizeWithNewValuesSolvesTheNewMatrix) {
+  SparseMatrix A = shell_like_matrix(3, 16);
+  const auto b = random_vector(A.pattern->n, 17);
+  for (const auto& name : linear_solver_names()) {
+    SparseMatrix B = A;
+    auto s = make_linear_solver(name);
+    s->factorize(B.view());
+    std::vector<double> x1(b.size()), x2(b.size());
+    s->solve(b.data(), x1.data());
+    for (auto& v : B.values) v *= 2.0;  // A2 = 2 A1: x2 = x1 / 2
+    s->factorize(B.view());
+    s->solve(b.data(), x2.data());
+    EXPECT_LT(relative_residual(B.view(), x2, b), 1e-12) << name;
+    double diff = 0, ref = 0;
+    for (size_t i = 0; i < b.size(); ++i) diff = std::max(diff, std::abs(x2[i] - 0.5 * x1[i])), ref = std::max(ref, std::abs(x1[i]));
+    EXPECT_LT(diff / ref, 1e-12) << name;
+    EXPECT_EQ(s->stats().analyses, 1) << name;
+  }
+}
+
+TEST(LinearSolver, SolveBeforeFactorizeThrows) {
+  const SparseMatrix A = shell_like_matrix(1, 18);
+  for (const auto& name : linear_solver_names()) {
+    auto s = make_linear_solver(name);
+    std::vector<double> x(A.pattern->n, 1.0);
+    EXPECT_FALSE(s->factorized()) << name;
+    EXPECT_THROW(s->solve(x.data(), x.data()), std::logic_error) << name;
+    s->analyze(A.view());
+    EXPECT_FALSE(s->factorized()) << name;
+    EXPECT_THROW(s->solve(x.data(), x.data()), std::logic_error) << name;
+    s->factorize(A.view());
+    EXPECT_TRUE(s->factorized()) << name;
+    s->analyze(A.view());  // a new analysis discards the factorization
+    EXPECT_FALSE(s->factorized()) << name;
+    EXPECT_THROW(s->solve(x.data(), x.data()), std::logic_error) << name;
+  }
+}
+
 TEST(LinearSolver, SpdMatrixKeepsCholmodSupernodal) {
   const SparseMatrix A = shell_like_matrix(3, 10);
   auto s = make_linear_solver("cholmod");
@@ -185,7 +255,7 @@ TEST(LinearSolver, SpdMatrixKeepsCholmodSupernodal) {
 }
 
 // No hidden threads: CHOLMOD's supernodal kernels open OpenMP regions with a fixed num_threads(4) and
-// OpenBLAS starts its own pool (lib/linear_solver.cpp). With one OpenMP thread requested, factorizing and
+// OpenBLAS (used by CHOLMOD and MUMPS) starts its own pool (lib/linear_solver.cpp). With one OpenMP thread requested, factorizing and
 // solving must not add a single thread to the process (counted in /proc/self/task). The matrix is large
 // enough (16 x 16 elements, 5445 unknowns) for supernodes wider than CHOLMOD's 32-column threshold.
 int process_threads() {
@@ -198,19 +268,39 @@ int process_threads() {
   return n;
 }
 
-TEST(LinearSolver, CholmodStartsNoHiddenThreads) {
+TEST(LinearSolver, NoBackEndStartsHiddenThreads) {
   if (process_threads() == 0) GTEST_SKIP() << "no /proc/self/task on this system";
   omp_set_num_threads(1);
   const SparseMatrix A = shell_like_matrix(16, 11);
-  const int before = process_threads();
-  auto s = make_linear_solver("cholmod");
-  s->factorize(A.view());
-  s->factorize(A.view());
   const std::vector<double> b = random_vector(A.pattern->n, 12);
-  std::vector<double> x(b.size());
-  s->solve(b.data(), x.data());
-  EXPECT_LT(relative_residual(A.view(), x, b), 1e-12);
-  EXPECT_EQ(process_threads(), before) << "CHOLMOD or its BLAS started threads beyond --threads";
+  for (const auto& name : linear_solver_names()) {
+    const int before = process_threads();
+    auto s = make_linear_solver(name);
+    s->factorize(A.view());
+    s->factorize(A.view());
+    std::vector<double> x(b.size());
+    s->solve(b.data(), x.data());
+    EXPECT_LT(relative_residual(A.view(), x, b), 1e-12) << name;
+    EXPECT_EQ(process_threads(), before) << name << " or its BLAS started threads beyond --threads";
+  }
+}
+
+// OpenBLAS creates its pool when it is loaded, before any solver exists, so the thread count above cannot
+// see whether the BLAS kernels of CHOLMOD and MUMPS run on one thread. Check the setting itself: raise the
+// OpenBLAS thread count, make the back-end, and expect it to be 1 again.
+TEST(LinearSolver, BlasBackEndsLimitOpenBlasToOneThread) {
+  using GetThreads = int (*)();
+  using SetThreads = void (*)(int);
+  const auto get = reinterpret_cast<GetThreads>(dlsym(RTLD_DEFAULT, "openblas_get_num_threads"));
+  const auto set = reinterpret_cast<SetThreads>(dlsym(RTLD_DEFAULT, "openblas_set_num_threads"));
+  if (get == nullptr || set == nullptr) GTEST_SKIP() << "the BLAS in this process is not OpenBLAS";
+  set(2);
+  if (get() != 2) GTEST_SKIP() << "OpenBLAS was built or started for a single thread";
+  for (const char* name : {"cholmod", "mumps"}) {
+    set(2);
+    auto s = make_linear_solver(name);
+    EXPECT_EQ(get(), 1) << name << " leaves OpenBLAS on more than one thread";
+  }
 }
 
 // A singular matrix (a zero row/column) must throw naming the back-end and the column.

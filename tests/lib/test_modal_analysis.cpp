@@ -159,13 +159,13 @@ TEST(LinearSolverInertia, NegativePivotsCountNegativeEigenvalues) {
   p.rowind = {0, 1, 0, 1, 2, 3, 2, 3};
   const std::vector<double> v = {3.0, 0.5, 0.5, -1.0, 2.0, 0.3, 0.3, -4.0};
   const CscView A{p.n, p.colptr.data(), p.rowind.data(), v.data()};
-  for (const char* name : {"eigen-ldlt", "cholmod"}) {
+  for (const char* name : {"eigen-ldlt", "cholmod", "mumps"}) {
     auto s = make_linear_solver(name);
     s->factorize(A);
     EXPECT_EQ(s->negative_pivots(), 2) << name;
   }
   const std::vector<double> pd = {3.0, 0.5, 0.5, 1.0, 2.0, 0.3, 0.3, 4.0};
-  for (const char* name : {"eigen-ldlt", "cholmod"}) {
+  for (const char* name : {"eigen-ldlt", "cholmod", "mumps"}) {
     auto s = make_linear_solver(name);
     s->factorize({p.n, p.colptr.data(), p.rowind.data(), pd.data()});
     EXPECT_EQ(s->negative_pivots(), 0) << name;
