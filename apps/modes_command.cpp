@@ -202,7 +202,7 @@ void add_modes_command(CLI::App& app, std::function<int()>& action, const std::s
                   "geometric and load stiffness) | static:LAMBDA (to load factor LAMBDA) | FILE (a saved state: a "
                   "checkpoint.cbor or run folder, or a run's DIR/fields/step_N.vtu at the time DIR/fields.pvd gives it)");
   sub->add_option("--dt", o->dt, "Time step to judge: adds steps per period for every mode and counts modes with < 20");
-  sub->add_option("--linear-solver", o->linear_solver, "Sparse factorization for (K - sigma M): eigen-ldlt (default), cholmod, klu");
+  sub->add_option("--linear-solver", o->linear_solver, "Sparse factorization for (K - sigma M): eigen-ldlt (default), cholmod, klu, mumps");
   sub->add_option("-o,--output", o->out_dir, "Result folder (default: results/<case>/modes)");
   sub->add_flag("--no-vtu", o->no_vtu, "Do not write the mode-shape VTU files");
   sub->callback([o, &action] { action = [o] { return run_modes(*o); }; });

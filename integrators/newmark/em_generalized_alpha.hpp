@@ -21,9 +21,11 @@
 //     setup_every [20] iterations instead); it starts from the Newmark predictor (predictor: none|newmark
 //     [newmark with modified, none with full]; none = u_n as in §6.4) and stops on the first of: the paper's
 //     cc ≤ cc_tol; the energy floor E_k = |Δu_k·P̄(u_{k−1})| ≤ e_floor·(K_0 + V_0 + |W_ext|) (e_floor [1e-20 with
-//     modified, 0 = off with full]; docs/theory.md §6.5); the scaled step test |Δu_i| ≤ step_tol max(1, |u_n,i|)
+//     modified, 0 = off with full]; docs/theory.md §6.5), with floor_test: correction|estimate [estimate with
+//     modified] (estimate: also accept u_k once 10 θ_E E_k, the estimated next correction, is below the floor);
+//     the scaled step test |Δu_i| ≤ step_tol max(1, |u_n,i|)
 //     (round-off reached; step_refresh = true: KINSOL's test instead, which refreshes K̄ and iterates once
-//     more). A step that fails is retried with full Newton. linear_solver: cholmod|eigen-ldlt|klu [cholmod],
+//     more). A step that fails is retried with full Newton. linear_solver: cholmod|eigen-ldlt|klu|mumps [cholmod],
 //   cc_tol [1e-12; 1e-14 with modified Newton] (paper eq. 39 energy ratio; the paper uses 1e-6), step_tol [1e-14],
 //   min_iters [1], max_iters [25],
 //   max_cuts [0] (step cutting: a failed step is retried as two half steps, recursively), hysteresis [1].
