@@ -180,7 +180,8 @@ void prepare_result_folder(const std::string& dir, bool overwrite) {
   check_output_folder(dir);
   static const char* outputs[] = {"run.json",    "run.json.tmp", "history.csv",  "fields.pvd", "fields.pvd.tmp",
                                   "checkpoint.cbor", "checkpoint.cbor.tmp", "run.json.reserve", "static.csv", "summary.csv",
-                                  "summary.md", "energy.png",  "momentum.png", "monitors.png", "work_precision.png"};
+                                  "summary.md", "energy.png",  "momentum.png", "monitors.png", "work_precision.png",
+                                  "modes.csv", "mode_shapes.csv", "modes.pvd"};
   std::error_code ec;
   const fs::path d(dir);
   if (!fs::is_directory(d, ec)) return;

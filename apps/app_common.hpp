@@ -52,7 +52,8 @@ bool run_python_script(const std::string& script, const std::vector<std::string>
 void check_output_folder(const std::string& dir);
 
 // Result folders are not silently reused: if `dir` already holds outputs of a shelldyn command
-// (run.json, history.csv, fields.pvd, fields/, checkpoint.cbor, static.csv, summary.csv, plots), this
+// (run.json, history.csv, fields.pvd, fields/, checkpoint.cbor, static.csv, summary.csv, plots,
+// modes.csv, mode_shapes.csv, modes.pvd), this
 // throws "use --overwrite" unless `overwrite`, which deletes exactly those outputs (nothing else) so
 // that no stale VTU or row of an earlier run can pass for this one. Also runs check_output_folder().
 void prepare_result_folder(const std::string& dir, bool overwrite);

@@ -27,7 +27,7 @@ struct ModesOptions {
   std::string case_path, out_dir, state = "initial", linear_solver = "eigen-ldlt", command;
   int num_modes = 10;
   double shift_hz = 0.0, dt = 0.0;
-  bool no_vtu = false;
+  bool no_vtu = false, overwrite = false;
 };
 
 // "initial" -> the reference state; "static" / "static:LAMBDA" -> the case solved statically (its
@@ -67,6 +67,7 @@ int run_modes(const ModesOptions& o) {
   Problem problem = load_problem(o.case_path);
   const Model& model = *problem.model;
   const std::string dir = o.out_dir.empty() ? (fs::path("results") / problem.spec.name / "modes").string() : o.out_dir;
+  prepare_result_folder(dir, o.overwrite);  // before the eigensolve: a reused folder is refused at once
   bool loaded = false;
   const State state = modes_state(problem, o.state, &loaded);
 
@@ -205,6 +206,7 @@ void add_modes_command(CLI::App& app, std::function<int()>& action, const std::s
   sub->add_option("--linear-solver", o->linear_solver, "Sparse factorization for (K - sigma M): eigen-ldlt (default), cholmod, klu, mumps");
   sub->add_option("-o,--output", o->out_dir, "Result folder (default: results/<case>/modes)");
   sub->add_flag("--no-vtu", o->no_vtu, "Do not write the mode-shape VTU files");
+  sub->add_flag("--overwrite", o->overwrite, "Replace the results of an earlier command in the result folder");
   sub->callback([o, &action] { action = [o] { return run_modes(*o); }; });
 }
 
