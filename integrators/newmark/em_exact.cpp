@@ -3,6 +3,7 @@
 #include "integrators/newmark/em_exact.hpp"
 
 #include "elements/exact_energy.hpp"
+#include "integrators/newmark/kept_iteration_matrix.hpp"
 #include "integrators/nonlinear/newton_solver.hpp"
 #include "lib/assembler.hpp"
 #include "lib/linear_solver.hpp"
@@ -93,16 +94,13 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
     c.scalars["W_ext"] = work_;
     c.scalars["W_presc"] = prescribed_work_;
     c.scalars["steps"] = static_cast<double>(steps_);
-    c.scalars["last_h"] = last_h_;
     c.scalars["diag_dissipation"] = diag_.dissipation;
     c.scalars["diag_min_step_dissipation"] = diag_.min_step_dissipation;
     c.scalars["diag_max_residual"] = diag_.max_residual;
     c.scalars["diag_max_beta_z"] = diag_.max_beta_z;
     c.scalars["diag_rigid_guards"] = static_cast<double>(diag_.rigid_guards);
     c.scalars["diag_residual_work"] = diag_.residual_work;
-    const int since = nopt_.modified ? newton_->iterations_since_setup() : -1;
-    c.scalars["newton_since_setup"] = since;
-    if (since >= 0) c.vectors["kbar"] = Eigen::Map<const Eigen::VectorXd>(kbar_.data(), static_cast<Index>(kbar_.size()));
+    kept_.save(c, *newton_, nopt_.modified);
   }
 
   void restore(SemiDiscreteSystem& sys, State& s, const IntegratorCheckpoint& c) override {
@@ -116,22 +114,13 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
     work_ = c.scalar("W_ext");
     prescribed_work_ = c.scalars.count("W_presc") ? c.scalar("W_presc") : 0.0;
     steps_ = static_cast<long>(c.scalar("steps"));
-    last_h_ = c.scalar("last_h");
     diag_.dissipation = c.scalar("diag_dissipation");
     diag_.min_step_dissipation = c.scalar("diag_min_step_dissipation");
     diag_.max_residual = c.scalar("diag_max_residual");
     diag_.max_beta_z = c.scalar("diag_max_beta_z");
     diag_.rigid_guards = static_cast<long>(c.scalar("diag_rigid_guards"));
     diag_.residual_work = c.scalars.count("diag_residual_work") ? c.scalar("diag_residual_work") : 0.0;
-    const int since = static_cast<int>(c.scalar("newton_since_setup"));
-    replay_kbar_ = false;
-    if (nopt_.modified && since >= 0) {
-      const Eigen::VectorXd& k = c.vector("kbar");
-      if (k.size() != sys.pattern()->nnz()) throw std::runtime_error("em-exact: checkpoint K̄ has the wrong size");
-      kbar_.assign(k.data(), k.data() + k.size());
-      replay_kbar_ = true;
-      newton_->resume_after_setup(since);
-    }
+    kept_.restore(c, *newton_, nopt_.modified, sys.pattern()->nnz(), "em-exact");
   }
 
   void initialize(SemiDiscreteSystem& sys, State& s) override {
@@ -231,14 +220,7 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
   bool step(State& s, double h, StepReport& rep, std::string* why, bool full_newton = false) {
     Model& sys = *model_;
     rep.chart_switches += sys.rechart(s, hysteresis_);  // between steps only; d, p, v, w unchanged
-    // K̄ depends on h. Steps that land on an output time differ from Δt in the last bits (t_out − t): no
-    // reason to throw a factorization away.
-    if (std::abs(h - last_h_) > 1e-8 * h) {
-      newton_->invalidate_jacobian();
-      if (replay_kbar_) newton_->resume_after_setup(0);  // a saved K̄ for another h is of no use
-      replay_kbar_ = false;
-    }
-    last_h_ = h;
+    kept_.start_step(h, *newton_);  // K̄ depends on h
     if (full_newton && !full_newton_) {
       NewtonOptions full = nopt_;
       full.modified = false;
@@ -291,10 +273,8 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
     };
     bool replayed = false;
     auto jacobian = [&](const double* up, SparseMatrix& J) {
-      if (replay_kbar_ && !full_newton) {  // first setup after restore(): the saved K̄, not a new one
+      if (!full_newton && kept_.replay(J)) {  // first setup after restore(): the saved K̄, not a new one
         // The uninterrupted run reuses this K̄ from an earlier step here: last_jacobian_iter stays 0.
-        J.values = kbar_;
-        replay_kbar_ = false;
         replayed = true;
         return;
       }
@@ -308,7 +288,7 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
       const double cm = 2.0 / (h * h);
       for (size_t k = 0; k < J.values.size(); ++k) J.values[k] = cm * M_.values[k] + 0.5 * K_.values[k];
       apply_dirichlet(sys.dofs(), J, nullptr);
-      if (nopt_.modified && !full_newton) kbar_ = J.values;  // for save()
+      if (nopt_.modified && !full_newton) kept_.keep(J);  // for save()
     };
     double first_step = 0.0;  // scaled size of the first correction
     auto hook = [&](int k, const double*, const double* du, const double*) -> bool {
@@ -426,11 +406,9 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
   Eigen::VectorXd un_, umid_, fint_, r_, last_u_, last_r_, uscale_;
   Eigen::VectorXd vn_, wn_, pn_, p1_, pmid_, v1_, w1_, mv_, mw_, fd_, g_;
   double work_ = 0.0, prescribed_work_ = 0.0;
-  double last_h_ = 0.0;
   long steps_ = 0;
   Data diag_;
-  std::vector<double> kbar_;   // the modified solver's last K̄ (checkpoints)
-  bool replay_kbar_ = false;   // restore(): the next setup of the modified solver uses kbar_
+  KeptIterationMatrix kept_;  // the modified solver's K̄ across steps and checkpoints
 };
 
 }  // namespace

@@ -1,5 +1,6 @@
 #include "integrators/newmark/em_generalized_alpha.hpp"
 
+#include "integrators/newmark/kept_iteration_matrix.hpp"
 #include "integrators/nonlinear/newton_solver.hpp"
 #include "lib/assembler.hpp"
 #include "lib/linear_solver.hpp"
@@ -149,11 +150,8 @@ class NewmarkFamily final : public Integrator {
     c.scalars["W_damp"] = damping_work_;
     c.scalars["W_presc"] = prescribed_work_;
     c.scalars["steps"] = static_cast<double>(steps_);
-    c.scalars["last_h"] = last_h_;
     c.scalars["energy0"] = energy0_;  // scale of the energy floor (initialize() would take the restored state's)
-    const int since = nopt_.modified ? newton_->iterations_since_setup() : -1;
-    c.scalars["newton_since_setup"] = since;
-    if (since >= 0) c.vectors["kbar"] = Eigen::Map<const Eigen::VectorXd>(kbar_.data(), static_cast<Index>(kbar_.size()));
+    kept_.save(c, *newton_, nopt_.modified);
   }
 
   void restore(SemiDiscreteSystem& sys, State& s, const IntegratorCheckpoint& c) override {
@@ -164,17 +162,8 @@ class NewmarkFamily final : public Integrator {
     damping_work_ = c.scalar("W_damp");
     prescribed_work_ = c.scalars.count("W_presc") ? c.scalar("W_presc") : 0.0;
     steps_ = static_cast<long>(c.scalar("steps"));
-    last_h_ = c.scalar("last_h");
     energy0_ = c.scalar("energy0");
-    const int since = static_cast<int>(c.scalar("newton_since_setup"));
-    replay_kbar_ = false;
-    if (nopt_.modified && since >= 0) {
-      const Eigen::VectorXd& k = c.vector("kbar");
-      if (k.size() != sys.pattern()->nnz()) throw std::runtime_error(name_ + ": checkpoint K̄ has the wrong size");
-      kbar_.assign(k.data(), k.data() + k.size());
-      replay_kbar_ = true;
-      newton_->resume_after_setup(since);
-    }
+    kept_.restore(c, *newton_, nopt_.modified, sys.pattern()->nnz(), name_);
   }
 
   void initialize(SemiDiscreteSystem& sys, State& s) override {
@@ -241,14 +230,7 @@ class NewmarkFamily final : public Integrator {
   // One step of size h from s (docs/theory.md §6.6). Returns false (s unchanged but for charts) on failure.
   bool step(SemiDiscreteSystem& sys, State& s, double h, StepReport& rep, std::string* why, bool full_newton = false) {
     rep.chart_switches += sys.rechart(s, hysteresis_);  // §2.3: between steps only
-    // K̄ depends on h (modified Newton). Steps that land on an output time differ from dt in the last bits
-    // (t_out − t); that is no reason to throw a factorization away.
-    if (std::abs(h - last_h_) > 1e-8 * h) {
-      newton_->invalidate_jacobian();
-      if (replay_kbar_) newton_->resume_after_setup(0);  // a saved K̄ for another h is of no use
-      replay_kbar_ = false;
-    }
-    last_h_ = h;
+    kept_.start_step(h, *newton_);  // K̄ depends on h (modified Newton)
     if (full_newton && !full_newton_) {
       NewtonOptions full = nopt_;
       full.modified = false;
@@ -313,9 +295,7 @@ class NewmarkFamily final : public Integrator {
     };
     bool replayed = false;
     auto jacobian = [&](const double* u, SparseMatrix& J) {
-      if (replay_kbar_ && !full_newton) {  // first setup after restore(): the saved K̄, not a new one
-        J.values = kbar_;
-        replay_kbar_ = false;
+      if (!full_newton && kept_.replay(J)) {  // first setup after restore(): the saved K̄, not a new one
         replayed = true;
         return;
       }
@@ -342,7 +322,7 @@ class NewmarkFamily final : public Integrator {
       for (size_t k = 0; k < J.values.size(); ++k) J.values[k] = du * M_.values[k] + (1 - af) * K_.values[k];
       sys.add_damping_matrix(cu, J);  // ∂(C u̇_mid)/∂u_{n+1} (docs/theory.md §8.5)
       apply_dirichlet(sys.dofs(), J, nullptr);
-      if (nopt_.modified && !full_newton) kbar_ = J.values;  // for save()
+      if (nopt_.modified && !full_newton) kept_.keep(J);  // for save()
     };
 
     Eigen::VectorXd u = un_;  // predictor u_{n+1}^(0) = u_n (§6.4)
@@ -429,12 +409,10 @@ class NewmarkFamily final : public Integrator {
   double step_tol_ = 1e-14;
   bool step_refresh_ = false;
   bool newmark_predictor_ = false;
-  double last_h_ = 0.0;
   long steps_ = 0;
-  std::vector<double> kbar_;   // the modified solver's last K̄ (checkpoints)
   double e_hist_[2] = {0.0, 0.0};  // E_{k−1}, E_{k−2} of the current step (floor_test = estimate)
   bool floor_estimate_ = false;
-  bool replay_kbar_ = false;   // restore(): the next setup of the modified solver uses kbar_
+  KeptIterationMatrix kept_;  // the modified solver's K̄ across steps and checkpoints
 };
 
 }  // namespace
