@@ -493,39 +493,43 @@ void write_compare_summaries(const CompareOptions& o, const Problem& first, doub
 
 }  // namespace
 
-CompareResult run_comparison(const CompareOptions& o) {
-  if (o.out_dir.empty()) throw std::invalid_argument("compare: an output folder is required");
-  const std::vector<CompareRun> runs = expand_compare_runs(o);
-  Problem first = load_problem(o.case_path);  // validates the case once, up front
-  const double loads_end = first.model->loads_end();
-  const double t_end = o.t_end >= 0.0 ? o.t_end : first.spec.time.t_end;
-  CompareResult result;
-  for (const auto& m : first.disc.monitors) result.monitors.push_back(m.name);
-  std::error_code ec;
-  fs::create_directories(o.out_dir, ec);
-  if (ec) throw std::runtime_error("cannot create the comparison folder '" + o.out_dir + "': " + ec.message());
+namespace {
+
+// One sweep of run_comparisons(): its runs, case, summaries; run(k) and finished(k, …) are called by the
+// shared executor batch for the sweep's own run index k.
+struct Sweep {
+  const CompareOptions& o;
+  std::vector<CompareRun> runs;
+  Problem first;
+  double loads_end = 0.0, t_end = 0.0;
   std::string case_bytes;
-  {
+  CompareResult result;
+  std::map<std::string, CsvTable> histories;
+  std::ostream* log = nullptr;
+
+  explicit Sweep(const CompareOptions& options)
+      : o(options), runs(expand_compare_runs(options)), first(load_problem(options.case_path)) {  // validates up front
+    loads_end = first.model->loads_end();
+    t_end = o.t_end >= 0.0 ? o.t_end : first.spec.time.t_end;
+    for (const auto& m : first.disc.monitors) result.monitors.push_back(m.name);
+    std::error_code ec;
+    fs::create_directories(o.out_dir, ec);
+    if (ec) throw std::runtime_error("cannot create the comparison folder '" + o.out_dir + "': " + ec.message());
     std::ifstream in(o.case_path, std::ios::binary);
     case_bytes.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+    result.rows.resize(runs.size());
+    for (size_t k = 0; k < runs.size(); ++k) {
+      CompareRow& row = result.rows[k];
+      row.run = runs[k];
+      row.out_dir = (fs::path(o.out_dir) / runs[k].label).string();
+      row.status = kNotFinished;
+    }
   }
 
-  result.rows.resize(runs.size());
-  std::vector<RunJob> jobs;
-  for (size_t k = 0; k < runs.size(); ++k) {
-    CompareRow& row = result.rows[k];
-    row.run = runs[k];
-    row.out_dir = (fs::path(o.out_dir) / runs[k].label).string();
-    row.status = kNotFinished;
-    jobs.push_back({runs[k].label, expected_cost(runs[k], t_end, first.spec.time.dt)});
-  }
-  std::unique_ptr<RunExecutor> own;
-  if (!o.executor) own = make_local_executor(o.jobs, o.threads);
-  RunExecutor& executor = o.executor ? *o.executor : *own;
-  std::ostream* log = executor.collects() ? o.log : nullptr;
+  double cost(size_t k) const { return expected_cost(runs[k], t_end, first.spec.time.dt); }
 
   // One run, on whichever thread or rank the executor chose: its own Problem, its own folder.
-  const RunFunction run_one = [&](size_t k, int threads) -> std::string {
+  std::string run(size_t k, int threads) const {
     const CompareRun& run = runs[k];
     const std::string dir = (fs::path(o.out_dir) / run.label).string();
     const std::string fingerprint = run_fingerprint(o, run, case_bytes);
@@ -575,12 +579,12 @@ CompareResult run_comparison(const CompareOptions& o) {
       if (out) fs::rename(tmp, dir + "/" + kOutcomeFile);
     }
     return payload;
-  };
+  }
 
   // On the collecting process: fill the row, rewrite the summary (every row, unfinished ones marked), so
   // that a sweep stopped at any point leaves a summary that lists every run.
-  std::map<std::string, CsvTable> histories;
-  const OutcomeCallback on_outcome = [&](size_t k, const RunOutcome& outcome, bool more) {
+  // `tag`: "[j/N] " of the run in the executor's batch, as in its start line.
+  void finished(size_t k, const RunOutcome& outcome, const std::string& tag) {
     CompareRow& row = result.rows[k];
     row.ok = outcome.ok;
     row.status = outcome.status;
@@ -594,7 +598,7 @@ CompareResult run_comparison(const CompareOptions& o) {
       try {
         decode_outcome(payload, row.summary, row.energy_error);
         if (log)
-          *log << "[" << k + 1 << "/" << runs.size() << "] " << row.run.label << ": " << row.summary.totals.steps << " steps, "
+          *log << tag << o.log_prefix << row.run.label << ": " << row.summary.totals.steps << " steps, "
                << num(row.summary.wall_seconds) << " s, "
                << (std::isnan(row.energy_error) ? std::string("no energy error after the loads (the run ends while they act)")
                                                 : "energy error after the loads " + num(row.energy_error))
@@ -604,15 +608,58 @@ CompareResult run_comparison(const CompareOptions& o) {
         row.status = "failed: unreadable result (" + one_line(e.what()) + ")";
       }
     }
-    if (!more) write_compare_summaries(o, first, loads_end, t_end, result, histories);
+    dirty = true;
+  }
+
+  bool dirty = false;  // rows changed since the summaries were last written
+  void write_summaries() {
+    dirty = false;
+    write_compare_summaries(o, first, loads_end, t_end, result, histories);
+  }
+};
+
+}  // namespace
+
+CompareResult run_comparison(const CompareOptions& o) { return std::move(run_comparisons({o}).front()); }
+
+std::vector<CompareResult> run_comparisons(const std::vector<CompareOptions>& sweeps) {
+  if (sweeps.empty()) return {};
+  for (const auto& o : sweeps)
+    if (o.out_dir.empty()) throw std::invalid_argument("compare: an output folder is required");
+  std::vector<std::unique_ptr<Sweep>> sw;
+  for (const auto& o : sweeps) sw.push_back(std::make_unique<Sweep>(o));
+  // One batch for all sweeps: job j is run `index[j].second` of sweep `index[j].first`.
+  std::vector<RunJob> jobs;
+  std::vector<std::pair<size_t, size_t>> index;
+  for (size_t s = 0; s < sw.size(); ++s)
+    for (size_t k = 0; k < sw[s]->runs.size(); ++k) {
+      jobs.push_back({sweeps[s].log_prefix + sw[s]->runs[k].label, sw[s]->cost(k)});
+      index.emplace_back(s, k);
+    }
+  const CompareOptions& o = sweeps.front();  // the executor and its settings
+  std::unique_ptr<RunExecutor> own;
+  if (!o.executor) own = make_local_executor(o.jobs, o.threads);
+  RunExecutor& executor = o.executor ? *o.executor : *own;
+  for (auto& s : sw) s->log = executor.collects() ? s->o.log : nullptr;
+  const RunFunction run_one = [&](size_t j, int threads) { return sw[index[j].first]->run(index[j].second, threads); };
+  // A terminated job reports its unfinished runs together (more = true until the last one): the summaries of
+  // the sweeps whose rows changed are rewritten once, at the last.
+  const OutcomeCallback on_outcome = [&](size_t j, const RunOutcome& outcome, bool more) {
+    sw[index[j].first]->finished(index[j].second, outcome,
+                                 "[" + std::to_string(j + 1) + "/" + std::to_string(jobs.size()) + "] ");
+    if (!more)
+      for (auto& s : sw)
+        if (s->dirty) s->write_summaries();
   };
-
-  if (executor.collects()) write_compare_summaries(o, first, loads_end, t_end, result, histories);
-  execute_runs(jobs, run_one, executor, on_outcome, log);
-  if (!executor.collects()) return result;
-  write_compare_summaries(o, first, loads_end, t_end, result, histories);
-  return result;
+  if (executor.collects())
+    for (auto& s : sw) s->write_summaries();
+  execute_runs(jobs, run_one, executor, on_outcome, sw.front()->log);
+  std::vector<CompareResult> out;
+  for (auto& s : sw) {
+    if (executor.collects()) s->write_summaries();
+    out.push_back(std::move(s->result));
+  }
+  return out;
 }
-
 
 }  // namespace shelldyn

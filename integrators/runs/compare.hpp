@@ -72,6 +72,7 @@ struct CompareOptions {
   std::string reference;            // label of the reference run (empty: automatic, see above)
   std::ostream* log = nullptr;      // one line per run start/finish
   std::string command;              // recorded in run.json and summary.md
+  std::string log_prefix;           // put before run labels in log lines (run_comparisons: e.g. "window/")
 };
 
 struct CompareRun {
@@ -110,6 +111,13 @@ std::vector<CompareRun> expand_compare_runs(const CompareOptions& options);
 // Runs the study and writes summary.csv / summary.md. Throws only for bad options or when the summary
 // cannot be written; failed runs are rows. On a non-collecting MPI rank the summary paths are empty.
 CompareResult run_comparison(const CompareOptions& options);
+
+// Several sweeps (e.g. the window and full groups of a study) in ONE batch of the executor of the first
+// (its jobs / threads / executor settings apply to all): runs start longest expected first across the sweeps,
+// so a long run of one sweep overlaps the short runs of the others instead of running alone at the end. Each
+// sweep keeps its own folder, summaries and result (returned in the order given); log lines number the runs
+// in the batch and put each sweep's log_prefix before its labels.
+std::vector<CompareResult> run_comparisons(const std::vector<CompareOptions>& sweeps);
 
 // history.csv (or any numeric CSV with a header row) as columns; "nan" parses as NaN.
 struct CsvTable {

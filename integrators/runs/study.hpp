@@ -1,8 +1,9 @@
 // The integrator study behind `shelldyn study BENCHMARK` (docs/results.md, "Integrator study"): for one of the
 // paper's benchmarks, a work–precision sweep of every time integrator on a window every method can afford,
-// plus full-duration conservation runs. Built on the comparison machinery of compare.hpp: every batch of runs
-// is one run_comparison() call (same specs, labels, settings inheritance and run execution), so the study
-// runs wherever and however `shelldyn compare` runs.
+// plus full-duration conservation runs. Built on the comparison machinery of compare.hpp: the groups' runs are
+// one run_comparisons() batch (same specs, labels, settings inheritance and run execution as `shelldyn
+// compare`, so the study runs wherever and however compare runs). Runs start longest expected first across
+// both groups, so the full group's long baseline run overlaps the window's runs instead of ending the study alone.
 //
 // Groups (sub-folders of the study folder):
 //   window/   the work–precision sweep on [0, window_t_end] (short enough for the explicit baseline, whose
@@ -11,7 +12,7 @@
 //             a Δt well below the sweep's) for displacement errors;
 //   full/     the case's full duration: every fixed-step scheme at full_dt and the cheapest baseline.
 // Resumable: a run whose <group>/<label>/run.json says "status": "complete" is not run again (delete its
-// folder, or pass rerun, to repeat it); only the missing runs go to run_comparison().
+// folder, or pass rerun, to repeat it); only the missing runs go to run_comparisons().
 // Per-run budget (max_wall_per_run / max_steps_per_run, the run driver's --max-wall / --max-steps): a run
 // that hits it stops at its next output time and is a row "stopped at budget" with the time it reached —
 // never a complete row, never a point of the work–precision diagram or the headline. It is kept on resume
@@ -74,7 +75,7 @@ struct StudyOptions {
                                           // they are (runs not made: "not run"; stopped mid-run: "not run (...)")
   double max_wall_per_run = 0.0;          // per-run budget in wall seconds (0: none; see above)
   long long max_steps_per_run = 0;        // per-run budget in steps, checked at output times (0: none)
-  CompareOptions execution;               // jobs / threads / executor handed to run_comparison() (MPI: every rank
+  CompareOptions execution;               // jobs / threads / executor handed to run_comparisons() (MPI: every rank
                                           // calls run_study; only the one with report = true writes the tables)
   bool report = true;
   std::ostream* log = nullptr;

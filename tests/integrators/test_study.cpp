@@ -1,5 +1,5 @@
 // `shelldyn study` machinery (integrators/runs/study.hpp) on a tiny preset: the runs are made through
-// run_comparison(), measured from their folders, and a second call resumes (runs nothing that completed).
+// run_comparisons(), measured from their folders, and a second call resumes (runs nothing that completed).
 #include "integrators/runs/study.hpp"
 
 #include <gtest/gtest.h>
@@ -161,6 +161,52 @@ TEST(Study, StoppedBudgetParsing) {
             (std::pair<std::string, double>{"max-steps", 6.0}));
   EXPECT_EQ(stopped_budget("complete").first, "");
   EXPECT_EQ(stopped_budget("interrupted: SIGINT at t = 1").first, "");
+}
+
+// The window and full groups go to the executor as ONE batch (run_comparisons), so the full group's long
+// baseline run starts first and overlaps the window's runs instead of running alone at the end. A recording
+// executor runs nothing: it checks what it is handed and reports every run as not run.
+class RecordingExecutor final : public RunExecutor {
+ public:
+  std::vector<std::vector<RunJob>> batches;
+  std::vector<RunOutcome> execute(const std::vector<RunJob>& jobs, const RunFunction&, const OutcomeCallback& on_outcome,
+                                  std::ostream*) override {
+    batches.push_back(jobs);
+    std::vector<RunOutcome> out(jobs.size());
+    for (size_t k = 0; k < jobs.size(); ++k) {
+      out[k].status = "failed: not run (recording executor)";
+      if (on_outcome) on_outcome(k, out[k], k + 1 < jobs.size());
+    }
+    return out;
+  }
+  int workers() const override { return 2; }
+  std::string describe() const override { return "recording executor"; }
+};
+
+TEST(Study, WindowAndFullGroupsAreOneBatchLongestFirst) {
+  const std::string dir = testing::TempDir() + "/shelldyn-study-batch";
+  fs::remove_all(dir);
+  StudyOptions o = tiny_study(dir);
+  o.groups = {"window", "full"};
+  o.preset.full_baselines = {"ida-bdf:rtol=0.0001"};
+  RecordingExecutor rec;
+  o.execution.executor = &rec;
+  const StudyResult r = run_study(o);
+  ASSERT_EQ(rec.batches.size(), 1u);  // one batch, not one per group
+  const std::vector<RunJob>& jobs = rec.batches.front();
+  ASSERT_EQ(jobs.size(), 6u);        // window: 2 em-galpha + reference + ida-bdf; full: em-galpha + ida-bdf
+  int window = 0, full = 0;
+  for (const auto& j : jobs) {
+    window += j.label.rfind("window/", 0) == 0;
+    full += j.label.rfind("full/", 0) == 0;
+  }
+  EXPECT_EQ(window, 4);
+  EXPECT_EQ(full, 2);
+  // The 20 s baseline run is the longest expected and starts first.
+  EXPECT_EQ(jobs[longest_first(jobs).front()].label, "full/ida-bdf_rtol=0.0001");
+  EXPECT_EQ(r.ran, 6);
+  for (const auto& x : r.rows) EXPECT_NE(x.status, "complete") << x.label;
+  fs::remove_all(dir);
 }
 
 TEST(Study, BadPresetFailsBeforeAnyRun) {
