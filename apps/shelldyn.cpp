@@ -535,38 +535,56 @@ struct StudyCommandOptions {
 };
 
 int run_study_command(const StudyCommandOptions& o) {
-  StudyOptions so;
-  so.preset = study_preset(o.benchmark);
-  so.case_path = o.case_path.empty() ? app::find_case_file(so.preset.case_file) : o.case_path;
+  // `all`: the three benchmarks in one batch of runs (run_studies), each into its own folder.
+  std::vector<std::string> benchmarks;
+  if (o.benchmark == "all") {
+    if (!o.case_path.empty()) throw std::invalid_argument("--case needs one benchmark, not 'all' (each benchmark has its own case)");
+    for (const auto& p : study_presets()) benchmarks.push_back(p.name);
+  } else {
+    benchmarks.push_back(o.benchmark);
+  }
   if (o.jobs < 1) throw std::invalid_argument("--jobs must be >= 1 (got " + std::to_string(o.jobs) + ")");
-  if (o.only == "window" || o.only == "full")
-    so.groups = {o.only};
-  else if (o.only != "all")
+  if (o.only != "window" && o.only != "full" && o.only != "all")
     throw std::invalid_argument("--only must be window, full or all (got '" + o.only + "')");
-  so.out_dir = o.out_dir.empty() ? (fs::path("results") / o.benchmark / "study").string() : o.out_dir;
   if (!(o.max_wall_per_run >= 0.0) || !std::isfinite(o.max_wall_per_run) || o.max_steps_per_run < 0)
     throw std::invalid_argument("--max-wall-per-run and --max-steps-per-run must be >= 0 (0: no budget)");
-  so.max_wall_per_run = o.max_wall_per_run;
-  so.max_steps_per_run = o.max_steps_per_run;
-  so.rerun = o.rerun;
-  so.dry_run = o.dry_run;
-  so.report_only = o.report_only;
-  so.execution.jobs = o.jobs;
-  so.log = &std::cout;
-  so.command = o.command;
-  if (!o.dry_run) app::check_output_folder(so.out_dir);
   // Where the runs execute: as `shelldyn compare` (the ranks of mpirun/srun, else --jobs threads).
   const std::unique_ptr<RunExecutor> executor = app::make_sweep_executor(o.jobs, 0);
-  so.execution.executor = executor.get();
-  so.report = executor->collects();
-  if (!so.report) so.log = nullptr;
-  const StudyResult r = run_study(so);
-  if (o.dry_run || !so.report) return 0;
-  std::cout << "study " << o.benchmark << ": " << r.ran << " runs made, " << r.skipped << " kept from earlier, " << r.stopped
-            << " stopped at the per-run budget, " << r.failed << " failed; wrote " << r.study_csv << ", " << r.study_md << std::endl;
-  if (!o.no_plots && app::run_python_script(app::find_script("plot_study.py"), {so.out_dir}, std::cout))
-    std::cout << "wrote " << so.out_dir << "/work_precision.png, full_energy.png, full_momentum.png" << std::endl;
-  return r.failed ? 3 : 0;
+  std::vector<StudyOptions> studies;
+  for (const auto& b : benchmarks) {
+    StudyOptions so;
+    so.preset = study_preset(b);
+    so.case_path = o.case_path.empty() ? app::find_case_file(so.preset.case_file) : o.case_path;
+    if (o.only != "all") so.groups = {o.only};
+    so.out_dir = o.out_dir.empty() ? (fs::path("results") / b / "study").string()
+                 : benchmarks.size() > 1 ? (fs::path(o.out_dir) / b).string()
+                                         : o.out_dir;
+    so.max_wall_per_run = o.max_wall_per_run;
+    so.max_steps_per_run = o.max_steps_per_run;
+    so.rerun = o.rerun;
+    so.dry_run = o.dry_run;
+    so.report_only = o.report_only;
+    so.execution.jobs = o.jobs;
+    so.execution.executor = executor.get();
+    so.report = executor->collects();
+    so.log = so.report ? &std::cout : nullptr;
+    so.command = o.command;
+    if (!o.dry_run) app::check_output_folder(so.out_dir);
+    studies.push_back(so);
+  }
+  const std::vector<StudyResult> results = run_studies(studies);
+  if (o.dry_run || !executor->collects()) return 0;
+  bool failed = false;
+  for (size_t i = 0; i < studies.size(); ++i) {
+    const StudyResult& r = results[i];
+    failed = failed || r.failed > 0;
+    std::cout << "study " << studies[i].preset.name << ": " << r.ran << " runs made, " << r.skipped << " kept from earlier, "
+              << r.stopped << " stopped at the per-run budget, " << r.failed << " failed; wrote " << r.study_csv << ", "
+              << r.study_md << std::endl;
+    if (!o.no_plots && app::run_python_script(app::find_script("plot_study.py"), {studies[i].out_dir}, std::cout))
+      std::cout << "wrote " << studies[i].out_dir << "/work_precision.png, full_energy.png, full_momentum.png" << std::endl;
+  }
+  return failed ? 3 : 0;
 }
 
 void add_study_command(CLI::App& app, Action& action, const std::string& command) {
@@ -577,10 +595,14 @@ void add_study_command(CLI::App& app, Action& action, const std::string& command
   CLI::App* sub = app.add_subcommand(
       "study", "Work-precision sweep of every integrator on a benchmark + full-duration conservation runs (resumable); "
                "write study.csv, study.md and plots");
-  sub->add_option("benchmark", o->benchmark, "Benchmark: " + names)->required();
+  sub->add_option("benchmark", o->benchmark,
+                  "Benchmark: " + names + ", or all (the three in one batch of runs, longest first; with -o DIR each goes "
+                  "to DIR/<benchmark>)")
+      ->required();
   sub->add_option("--case", o->case_path, "Case file to use instead of apps/cases/<benchmark>.yaml (same preset)");
   sub->add_option("-o,--output", o->out_dir, "Result folder (default: results/<benchmark>/study)");
-  sub->add_option("--jobs", o->jobs, "Runs at a time, each single-threaded (default 2)");
+  sub->add_option("--jobs", o->jobs, "Runs at a time, each single-threaded (default 2); the runs of all groups (and with "
+                                     "'all' of all benchmarks) form one batch, longest expected first");
   sub->add_option("--only", o->only, "Run only the group window (work-precision sweep) or full (full duration); default all");
   sub->add_option("--max-wall-per-run", o->max_wall_per_run,
                   "Budget per run in wall seconds (default 0: none); a run that hits it is reported as stopped at budget "

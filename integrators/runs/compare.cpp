@@ -526,7 +526,11 @@ struct Sweep {
     }
   }
 
-  double cost(size_t k) const { return expected_cost(runs[k], t_end, first.spec.time.dt); }
+  // Expected cost for the longest-first order of a batch: steps × unknowns, so that runs of different meshes
+  // (run_comparisons of several benchmarks) compare too.
+  double cost(size_t k) const {
+    return expected_cost(runs[k], t_end, first.spec.time.dt) * static_cast<double>(first.model->num_dofs());
+  }
 
   // One run, on whichever thread or rank the executor chose: its own Problem, its own folder.
   std::string run(size_t k, int threads) const {

@@ -11,6 +11,7 @@
 #include <fstream>
 #include <limits>
 #include <map>
+#include <memory>
 #include <sstream>
 #include <stdexcept>
 
@@ -189,20 +190,31 @@ double run_json_number(const std::string& text, const std::string& key) {
   return end == begin ? NaN : x;
 }
 
-StudyResult run_study(const StudyOptions& o) {
+namespace {
+
+// What a study decided before running anything (plan_study), and what its report needs (report_study).
+struct StudyPlan {
+  Problem first;  // the case, validated once up front
+  double loads_end = 0.0;
+  std::vector<std::string> monitors;
+  StudyResult result;
+  std::map<std::string, std::vector<std::pair<PlannedRun, std::string>>> labelled;  // group -> (run, label)
+  std::vector<CompareOptions> batch;  // the groups' pending runs
+  explicit StudyPlan(Problem p) : first(std::move(p)) {}
+};
+
+std::unique_ptr<StudyPlan> plan_study(const StudyOptions& o) {
   if (o.out_dir.empty()) throw std::invalid_argument("study: an output folder is required");
   const StudyPreset& p = o.preset;
-  Problem first = load_problem(o.case_path);  // validates the case once, up front
-  const double loads_end = first.model->loads_end();
-  std::vector<std::string> monitors;
-  for (const auto& m : first.disc.monitors) monitors.push_back(m.name);
+  auto sp = std::make_unique<StudyPlan>(load_problem(o.case_path));  // validates the case once, up front
+  sp->loads_end = sp->first.model->loads_end();
+  for (const auto& m : sp->first.disc.monitors) sp->monitors.push_back(m.name);
+  StudyResult& result = sp->result;
+  auto& labelled = sp->labelled;
   auto say = [&](const std::string& line) {
     if (o.log) *o.log << line << std::endl;
   };
 
-  StudyResult result;
-  std::map<std::string, std::vector<std::pair<PlannedRun, std::string>>> labelled;  // group -> (run, label)
-  std::vector<CompareOptions> batch;  // the groups' pending runs
   for (const auto& group : o.groups) {
     const std::vector<PlannedRun> runs = plan(p, group);
     CompareOptions co = o.execution;
@@ -244,12 +256,21 @@ StudyResult run_study(const StudyOptions& o) {
         (o.report_only ? " not run (report only)" : " to run") + " -> " + co.out_dir);
     if (o.dry_run || o.report_only || pending.empty()) continue;
     co.specs = pending;
-    co.log_prefix = group + "/";
-    batch.push_back(co);
+    co.log_prefix = p.name + "/" + group + "/";
+    sp->batch.push_back(co);
   }
-  // Both groups in one batch (run_comparisons): the full group's long runs start first and overlap the window's.
-  for (const CompareResult& cr : run_comparisons(batch)) result.ran += static_cast<int>(cr.rows.size());
+  return sp;
+}
 
+
+// The rows from the run folders (resumed runs included), study.csv and study.md.
+StudyResult report_study(const StudyOptions& o, StudyPlan& plan) {
+  const StudyPreset& p = o.preset;
+  const Problem& first = plan.first;
+  const double loads_end = plan.loads_end;
+  const std::vector<std::string>& monitors = plan.monitors;
+  StudyResult& result = plan.result;
+  auto& labelled = plan.labelled;
   if (!o.report) return result;  // an MPI worker rank: rank 0 reports
 
   // --- rows from the run folders (resumed runs included) -------------------------------------------------
@@ -443,5 +464,27 @@ StudyResult run_study(const StudyOptions& o) {
   }
   return result;
 }
+
+}  // namespace
+
+std::vector<StudyResult> run_studies(const std::vector<StudyOptions>& studies) {
+  std::vector<std::unique_ptr<StudyPlan>> plans;
+  for (const auto& o : studies) plans.push_back(plan_study(o));  // every case and spec checked before any run
+  // One batch for all studies and groups (run_comparisons): the longest runs start first wherever they are.
+  std::vector<CompareOptions> batch;
+  std::vector<size_t> owner;
+  for (size_t i = 0; i < plans.size(); ++i)
+    for (const auto& co : plans[i]->batch) {
+      batch.push_back(co);
+      owner.push_back(i);
+    }
+  const std::vector<CompareResult> ran = run_comparisons(batch);
+  for (size_t j = 0; j < ran.size(); ++j) plans[owner[j]]->result.ran += static_cast<int>(ran[j].rows.size());
+  std::vector<StudyResult> out;
+  for (size_t i = 0; i < plans.size(); ++i) out.push_back(report_study(studies[i], *plans[i]));
+  return out;
+}
+
+StudyResult run_study(const StudyOptions& o) { return run_studies({o}).front(); }
 
 }  // namespace shelldyn

@@ -102,6 +102,11 @@ struct StudyResult {
 
 StudyResult run_study(const StudyOptions& options);
 
+// Several studies (e.g. all three benchmarks: `shelldyn study all`) in one batch of the executor of the first
+// (execution settings of the first apply to all): runs start longest expected first across every study and
+// group. Every case and spec is checked before anything runs. Results in the order given.
+std::vector<StudyResult> run_studies(const std::vector<StudyOptions>& studies);
+
 // The value of "key" in the "summary" object of a run.json (NaN if absent), and its "status".
 double run_json_number(const std::string& run_json_text, const std::string& key);
 std::string run_json_status(const std::string& run_json_text);

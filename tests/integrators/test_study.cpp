@@ -197,16 +197,29 @@ TEST(Study, WindowAndFullGroupsAreOneBatchLongestFirst) {
   ASSERT_EQ(jobs.size(), 6u);        // window: 2 em-galpha + reference + ida-bdf; full: em-galpha + ida-bdf
   int window = 0, full = 0;
   for (const auto& j : jobs) {
-    window += j.label.rfind("window/", 0) == 0;
-    full += j.label.rfind("full/", 0) == 0;
+    window += j.label.rfind("flying-plate-tiny/window/", 0) == 0;  // log labels: preset/group/run
+    full += j.label.rfind("flying-plate-tiny/full/", 0) == 0;
   }
   EXPECT_EQ(window, 4);
   EXPECT_EQ(full, 2);
   // The 20 s baseline run is the longest expected and starts first.
-  EXPECT_EQ(jobs[longest_first(jobs).front()].label, "full/ida-bdf_rtol=0.0001");
+  EXPECT_EQ(jobs[longest_first(jobs).front()].label, "flying-plate-tiny/full/ida-bdf_rtol=0.0001");
   EXPECT_EQ(r.ran, 6);
   for (const auto& x : r.rows) EXPECT_NE(x.status, "complete") << x.label;
+
+  // Two studies (`shelldyn study all`): still one batch, each study reporting its own rows.
+  StudyOptions o2 = o;
+  o2.preset.name = "flying-plate-tiny-2";
+  o2.out_dir = dir + "-2";
+  const std::vector<StudyResult> both = run_studies({o, o2});
+  ASSERT_EQ(rec.batches.size(), 2u);  // the first call's batch + exactly one more
+  EXPECT_EQ(rec.batches.back().size(), 12u);
+  ASSERT_EQ(both.size(), 2u);
+  EXPECT_EQ(both[0].rows.size(), 6u);
+  EXPECT_EQ(both[1].rows.size(), 6u);
+  EXPECT_EQ(both[1].ran, 6);
   fs::remove_all(dir);
+  fs::remove_all(dir + "-2");
 }
 
 TEST(Study, BadPresetFailsBeforeAnyRun) {
