@@ -262,7 +262,6 @@ std::unique_ptr<StudyPlan> plan_study(const StudyOptions& o) {
   return sp;
 }
 
-
 // The rows from the run folders (resumed runs included), study.csv and study.md.
 StudyResult report_study(const StudyOptions& o, StudyPlan& plan) {
   const StudyPreset& p = o.preset;

@@ -8,7 +8,8 @@ whose loads end at t = 0.1 s and whose full-duration runs last 0.3 s: all runs c
 Then plot_study.py writes work_precision.png, full_energy.png and full_momentum.png, and each must be a PNG
 of a sensible size with coloured curves in it: a figure with axes, labels and grid but no data has almost
 no saturated pixels (checked here on such a figure, so the measure can fail), a figure with the study's
-curves has thousands. Exits 77 (ctest: skipped) when matplotlib is not installed.
+curves has thousands. scripts/study_tables.py (next to PLOT_STUDY_PY) must print one complete row per
+method and per full-duration run. Exits 77 (ctest: skipped) when matplotlib is not installed.
 """
 import importlib.util
 import os
@@ -125,6 +126,23 @@ def main():
         if frac < MIN_COLOURED_FRACTION or colours < MIN_COLOURS:
             fail(f"{name} has almost no curves: {frac:.2%} coloured pixels (>= {MIN_COLOURED_FRACTION:.1%} expected), "
                  f"{colours} curve colours (>= {MIN_COLOURS} expected)")
+
+    # scripts/study_tables.py (the README's compact tables): one row per method in the window table, every
+    # run of this study complete, one row per full-duration run.
+    tables = run([sys.executable, os.path.join(os.path.dirname(plot_script), "study_tables.py"), study])
+    window, _, full = tables.partition("\n\n")
+    wrows = [l for l in window.splitlines()[2:] if l.startswith("| ")]
+    frows = [l for l in full.splitlines()[2:] if l.startswith("| ")]
+    methods = {l.split(" | ")[0][2:] for l in wrows}
+    expected = {"ida-bdf", "arkode-dirk", "arkode-erk", "em-galpha", "em-exact", "galpha ρ∞=1", "galpha ρ∞=0.8",
+                "midpoint", "newmark"}
+    if methods != expected:
+        fail(f"study_tables.py window rows {sorted(methods)}, expected {sorted(expected)}:\n{tables}")
+    if any(" 4 of 4 " not in l for l in wrows):
+        fail("study_tables.py: a method without 4 of 4 complete runs:\n" + tables)
+    if len(frows) != 7 or any(not l.endswith("| complete |") for l in frows):
+        fail(f"study_tables.py: {len(frows)} full-duration rows (7 complete expected):\n{tables}")
+    print(f"study_tables.py: {len(wrows)} methods, {len(frows)} full-duration runs")
     print("PASS")
 
 
