@@ -506,6 +506,7 @@ struct Sweep {
   CompareResult result;
   std::map<std::string, CsvTable> histories;
   std::ostream* log = nullptr;
+  bool dirty = false;  // rows changed since the summaries were last written
 
   explicit Sweep(const CompareOptions& options)
       : o(options), runs(expand_compare_runs(options)), first(load_problem(options.case_path)) {  // validates up front
@@ -615,7 +616,6 @@ struct Sweep {
     dirty = true;
   }
 
-  bool dirty = false;  // rows changed since the summaries were last written
   void write_summaries() {
     dirty = false;
     write_compare_summaries(o, first, loads_end, t_end, result, histories);
