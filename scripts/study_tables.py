@@ -68,13 +68,13 @@ def full_table(rows):
            "|---|---|---|---|---|---|---|---|"]
     for r in full:
         status = "complete" if r["status"] == "complete" else r["status"].split(" (")[0]
-        if status != "complete":  # no after-the-loads measures
-            out.append(f"| {r['label']} | {r['steps']} | {cpu(r['cpu_s'])} | {g(r['t_reached'], 4)} of {g(r['t_end'], 4)} | "
-                       f"– | – | – | {status} |")
-            continue
+        if status == "complete":
+            measures = (f"{g(r['energy_error_after_loads'])} | {g(r['max_dL'])} ({g(r['norm_L_ref'])}) | "
+                        f"{g(r['max_dJ'])} ({g(r['norm_J_ref'])})")
+        else:  # stopped or failed: no after-the-loads measures
+            measures = "– | – | –"
         out.append(f"| {r['label']} | {r['steps']} | {cpu(r['cpu_s'])} | {g(r['t_reached'], 4)} of {g(r['t_end'], 4)} | "
-                   f"{g(r['energy_error_after_loads'])} | {g(r['max_dL'])} ({g(r['norm_L_ref'])}) | "
-                   f"{g(r['max_dJ'])} ({g(r['norm_J_ref'])}) | {status} |")
+                   f"{measures} | {status} |")
     return "\n".join(out)
 
 
