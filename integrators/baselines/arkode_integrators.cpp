@@ -1,6 +1,8 @@
 #include "integrators/baselines/arkode_integrators.hpp"
 
+#include "integrators/baselines/second_order_newton.hpp"
 #include "integrators/baselines/sundials_baseline.hpp"
+#include "integrators/sundials/callback_linear_solver.hpp"
 #include "integrators/sundials/sundials_support.hpp"
 #include "lib/assembler.hpp"
 
@@ -127,7 +129,7 @@ class ArkodeIntegrator final : public SundialsBaseline {
 
   long factorizations() const override {
     long f = fos_->mass_factorizations();
-    if (newton_solver_) f += newton_solver_->stats().factorizations;
+    if (newton_) f += newton_->backend().stats().factorizations;
     return f;
   }
 
@@ -171,50 +173,13 @@ class ArkodeIntegrator final : public SundialsBaseline {
     mem_ = nullptr;
   }
 
-  // --- the Newton solver of arkode-dirk (header): custom matrix + custom solver + linsys function ---
+  // --- the Newton solver of arkode-dirk (header): placeholder matrix + callback solver + linsys function ---
   void setup_newton_solver(SemiDiscreteSystem& system) {
-    K_.pattern = M_.pattern = S_.pattern = system.pattern();
-    K_.values.assign(static_cast<size_t>(system.pattern()->nnz()), 0.0);
-    M_.values = S_.values = K_.values;
-    newton_solver_ = make_linear_solver(linear_solver_);
-    bq_.resize(n_);
-    rhs_.resize(n_);
-    tmp_.resize(n_);
-    xq_.resize(n_);
-    zc_.resize(n_);
-
-    A_.reset(SUNMatNewEmpty(*ctx_));
-    check_ptr(A_.get(), "SUNMatNewEmpty");
-    A_->content = this;
-    A_->ops->getid = [](SUNMatrix) { return SUNMATRIX_CUSTOM; };
-    A_->ops->destroy = [](SUNMatrix A) { SUNMatFreeEmpty(A); };
-    A_->ops->clone = [](SUNMatrix A) -> SUNMatrix {
-      SUNMatrix B = SUNMatNewEmpty(A->sunctx);
-      if (B == nullptr) return nullptr;
-      if (SUNMatCopyOps(A, B) != 0) {
-        SUNMatFreeEmpty(B);
-        return nullptr;
-      }
-      B->content = A->content;
-      return B;
-    };
-
-    LS_.reset(SUNLinSolNewEmpty(*ctx_));
-    check_ptr(LS_.get(), "SUNLinSolNewEmpty");
-    LS_->content = this;
-    LS_->ops->gettype = [](SUNLinearSolver) { return SUNLINEARSOLVER_DIRECT; };
-    LS_->ops->getid = [](SUNLinearSolver) { return SUNLINEARSOLVER_CUSTOM; };
-    LS_->ops->initialize = [](SUNLinearSolver) { return static_cast<int>(SUNLS_SUCCESS); };
-    LS_->ops->setup = ls_setup;
-    LS_->ops->solve = ls_solve;
-    LS_->ops->lastflag = [](SUNLinearSolver S) {
-      return static_cast<sunindextype>(static_cast<ArkodeIntegrator*>(S->content)->ls_flag_);
-    };
-    LS_->ops->free = [](SUNLinearSolver S) {
-      S->content = nullptr;
-      SUNLinSolFreeEmpty(S);
-      return static_cast<int>(SUNLS_SUCCESS);
-    };
+    newton_ = std::make_unique<SecondOrderNewton>(system.pattern(), system.dofs(), linear_solver_);
+    system.add_damping_matrix(1.0, newton_->G);  // C: constant (reference state), zero without damping
+    A_ = make_placeholder_matrix(*ctx_);
+    LS_ = make_callback_linear_solver(*ctx_, {[this] { return ls_setup(); },
+                                              [this](const double* b, double* x) { return ls_solve(b, x); }});
     check(ARKStepSetLinearSolver(mem_, LS_.get(), A_.get()), "ARKStepSetLinearSolver");
     check(ARKStepSetLinSysFn(mem_, linsys), "ARKStepSetLinSysFn");
     check(ARKStepSetMaxNonlinIters(mem_, max_nonlin_), "ARKStepSetMaxNonlinIters");
@@ -229,9 +194,9 @@ class ArkodeIntegrator final : public SundialsBaseline {
       if (!jok) {
         State& s = self->work_;
         self->fos_->unpack(N_VGetArrayPointer(y), s);
-        self->sys_->internal(s.u, s.charts, nullptr, &self->K_);
-        self->sys_->add_load_stiffness(t, s.u, s.charts, self->K_);
-        self->sys_->mass(s.u, s.charts, self->M_);
+        self->sys_->internal(s.u, s.charts, nullptr, &self->newton_->K);
+        self->sys_->add_load_stiffness(t, s.u, s.charts, self->newton_->K);
+        self->sys_->mass(s.u, s.charts, self->newton_->M);
         *jcur = SUNTRUE;
       } else {
         *jcur = SUNFALSE;
@@ -247,64 +212,30 @@ class ArkodeIntegrator final : public SundialsBaseline {
   }
 
   // Factorize S = M + γC + γ²K with constrained rows/columns as identity (Schur complement, header;
-  // C = 0 without damping).
-  static int ls_setup(SUNLinearSolver S, SUNMatrix) {
-    auto* self = static_cast<ArkodeIntegrator*>(S->content);
+  // docs/theory/baseline-newton.md).
+  int ls_setup() {
     try {
-      const double g2 = self->gamma_ * self->gamma_;
-      for (size_t k = 0; k < self->S_.values.size(); ++k)
-        self->S_.values[k] = self->M_.values[k] + g2 * self->K_.values[k];
-      self->sys_->add_damping_matrix(self->gamma_, self->S_);
-      apply_dirichlet(self->sys_->dofs(), self->S_, nullptr, 1.0);
-      self->newton_solver_->factorize(self->S_.view());
-      self->gamma_factored_ = self->gamma_;
-      return self->ls_flag_ = SUNLS_SUCCESS;
+      newton_->factorize(gamma_);
+      return SUNLS_SUCCESS;
     } catch (...) {
-      self->errors_.capture("arkode-dirk Newton-matrix factorization");
-      return self->ls_flag_ = SUNLS_PACKAGE_FAIL_REC;
+      errors_.capture("arkode-dirk Newton-matrix factorization");
+      return SUNLS_PACKAGE_FAIL_REC;
     }
   }
 
-  static int ls_solve(SUNLinearSolver S, SUNMatrix, N_Vector x, N_Vector b, sunrealtype) {
-    auto* self = static_cast<ArkodeIntegrator*>(S->content);
+  // (I − γJ) x = b: the block system of second_order_newton.hpp with r_q = b_q, m = b_v (momentum rows
+  // M x_v + γ K x_q + γ C x_v = M b_v). The w and d rows are the identity: their coupling to v is left out; they
+  // do not feed back, so the Newton iteration still converges to them.
+  int ls_solve(const double* b, double* x) {
     try {
-      const Index n = self->n_;
-      const double g = self->gamma_factored_;
-      const double* bp = N_VGetArrayPointer(b);
-      double* xp = N_VGetArrayPointer(x);
-      const DofMap& dofs = self->sys_->dofs();
-      Eigen::Map<const Eigen::VectorXd> b_q(bp, n), b_v(bp + n, n);
-      // Free rows: (M_ff + γ²K_ff) x_q,f = M_ff (b_q + γ b_v)_f − γ² K_fc x_q,c. With damping the v rows
-      // M x_v + γ K x_q + γ C x_v = M b_v give, with x_v = (x_q − b_q)/γ, S = M + γC + γ²K and the extra
-      // right-hand side γ C_ff b_q,f − γ² C_fc b_v,c.
-      self->bq_ = b_q + g * b_v;
-      self->xq_.setZero();
-      for (Index c : dofs.constrained_dofs()) {
-        self->xq_[c] = self->bq_[c];
-        self->bq_[c] = 0.0;
-      }
-      multiply(self->M_.view(), self->bq_.data(), self->rhs_.data());
-      if (dofs.num_constrained() > 0) {
-        multiply(self->K_.view(), self->xq_.data(), self->tmp_.data());
-        self->rhs_ -= g * g * self->tmp_;
-      }
-      if (self->sys_->has_damping()) {
-        self->zc_ = b_q;  // b_q,f and −γ b_v,c in one vector: C (b_q,f − γ b_v,c) scaled by γ
-        for (Index c : dofs.constrained_dofs()) self->zc_[c] = -g * bp[n + c];
-        self->sys_->damping_force(self->zc_, self->tmp_.data());
-        self->rhs_ += g * self->tmp_;
-      }
-      for (Index c : dofs.constrained_dofs()) self->rhs_[c] = self->xq_[c];
-      self->newton_solver_->solve(self->rhs_.data(), xp);
-      for (Index i = 0; i < n; ++i) xp[n + i] = (xp[i] - bp[i]) / g;
-      for (Index c : dofs.constrained_dofs()) xp[n + c] = bp[n + c];
-      xp[2 * n] = bp[2 * n];          // w and d rows: identity (their coupling to v is left out; they do
-      xp[2 * n + 1] = bp[2 * n + 1];  // not feed back, so the Newton iteration still converges to them)
-      if (!all_finite(xp, 2 * n + 2)) return self->ls_flag_ = SUNLS_PACKAGE_FAIL_REC;
-      return self->ls_flag_ = SUNLS_SUCCESS;
+      const Index n = n_;
+      newton_->solve(b, b + n, nullptr, x, x + n);
+      x[2 * n] = b[2 * n];
+      x[2 * n + 1] = b[2 * n + 1];
+      return all_finite(x, 2 * n + 2) ? SUNLS_SUCCESS : SUNLS_PACKAGE_FAIL_REC;
     } catch (...) {
-      self->errors_.capture("arkode-dirk Newton solve");
-      return self->ls_flag_ = SUNLS_PACKAGE_FAIL_UNREC;
+      errors_.capture("arkode-dirk Newton solve");
+      return SUNLS_PACKAGE_FAIL_UNREC;
     }
   }
 
@@ -387,11 +318,8 @@ class ArkodeIntegrator final : public SundialsBaseline {
   Eigen::VectorXd a_;
 
   // Newton solver of arkode-dirk
-  std::unique_ptr<LinearSolver> newton_solver_;
-  SparseMatrix K_, M_, S_;
-  double gamma_ = 0.0, gamma_factored_ = 0.0;
-  int ls_flag_ = SUNLS_SUCCESS;
-  Eigen::VectorXd bq_, rhs_, tmp_, xq_, zc_;
+  std::unique_ptr<SecondOrderNewton> newton_;
+  double gamma_ = 0.0;
 
   ArkCounters base_;
 };

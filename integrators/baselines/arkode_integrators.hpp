@@ -8,15 +8,16 @@
 // constrained DOFs get v̇_c = 0.
 //
 // arkode-dirk Newton matrix. The exact Jacobian of M⁻¹(...) is dense and is never formed. ARKODE is
-// given a user linear-system function (ARKStepSetLinSysFn) and a matrix-less custom SUNMatrix/
-// SUNLinearSolver pair (type DIRECT): ARKODE keeps its own setup heuristics (re-evaluation every 20
+// given a user linear-system function (ARKStepSetLinSysFn) and a placeholder SUNMatrix with a callback
+// SUNLinearSolver (integrators/sundials/callback_linear_solver.hpp): ARKODE keeps its own setup heuristics (re-evaluation every 20
 // steps, on γ changes > 20 % and after convergence failures), the linear-system function assembles
 // K(q) − K_load and M(q) when ARKODE asks for a new Jacobian (jok = false) and only records γ
 // otherwise, and the solver solves (I − γJ) x = b with the approximation
 //
 //     J ≈ [[0, I, 0, 0]; [−M⁻¹K, −M⁻¹C, 0, 0]; [0, 0, 0, 0]; [0, 0, 0, 0]]   (y = [q; v; w; d])
 //
-// by the Schur complement (symmetric, factorized with linear_solver: eigen-ldlt|cholmod|mumps|klu):
+// by the Schur complement (symmetric, factorized with linear_solver: eigen-ldlt|cholmod|mumps|klu;
+// integrators/baselines/second_order_newton.hpp, shared with ida-bdf, docs/theory/baseline-newton.md §2):
 //
 //     (M + γC + γ²K) x_q = M (b_q + γ b_v) + γ C b_q,   x_v = (x_q − b_q)/γ,   x_w = b_w,   x_d = b_d,
 //

@@ -1,13 +1,15 @@
 #include "integrators/baselines/ida_bdf.hpp"
 
+#include "integrators/baselines/second_order_newton.hpp"
 #include "integrators/baselines/sundials_baseline.hpp"
-#include "integrators/sundials/sun_linear_solver.hpp"
+#include "integrators/sundials/callback_linear_solver.hpp"
 #include "integrators/sundials/sundials_support.hpp"
 #include "lib/assembler.hpp"
 
 #include <ida/ida.h>
 #include <ida/ida_ls.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <sstream>
@@ -24,18 +26,25 @@ class IdaBdf final : public SundialsBaseline {
  public:
   IdaBdf(IntegratorSettings& s, double /*dt: IDA chooses its own steps (init_step)*/) : SundialsBaseline("ida-bdf", s) {
     max_order_ = s.get("max_order", 2);
-    linear_solver_ = s.get("linear_solver", "klu");
     jacobian_ = s.get("jacobian", "approximate");
+    // The Newton matrix is solved through its n × n Schur complement S = c_j² M + c_j G + K
+    // (docs/theory/baseline-newton.md): symmetric with the approximate Jacobian, so Cholesky by default;
+    // fd-inertia's G and K are not symmetric and need an LU.
+    linear_solver_ = s.get("linear_solver", jacobian_ == "fd-inertia" ? "klu" : "cholmod");
     dcj_lsetup_ = s.get("delta_cj_lsetup", 0.25);
     if (max_order_ < 1 || max_order_ > 5)
       throw std::invalid_argument("ida-bdf: max_order must be 1..5, got " + std::to_string(max_order_));
-    if (linear_solver_ != "klu")
-      throw std::invalid_argument("ida-bdf: linear_solver '" + linear_solver_ +
-                                  "' is not supported: the IDA iteration matrix [[c_j I, -I], [K, c_j M]] is "
-                                  "not symmetric, and only klu factors non-symmetric matrices");
     if (jacobian_ != "approximate" && jacobian_ != "fd-inertia")
       throw std::invalid_argument("ida-bdf: jacobian must be 'approximate' or 'fd-inertia', got '" + jacobian_ +
                                   "'");
+    const auto names = linear_solver_names();
+    if (std::find(names.begin(), names.end(), linear_solver_) == names.end())
+      throw std::invalid_argument("ida-bdf: unknown linear_solver '" + linear_solver_ +
+                                  "' (the Newton matrix's Schur complement is symmetric: cholmod, eigen-ldlt, mumps or "
+                                  "klu)");
+    if (jacobian_ == "fd-inertia" && linear_solver_ != "klu")
+      throw std::invalid_argument("ida-bdf: jacobian=fd-inertia gives a non-symmetric Newton matrix; linear_solver '" +
+                                  linear_solver_ + "' factors symmetric matrices only, use linear_solver=klu");
     if (!(dcj_lsetup_ > 0.0 && dcj_lsetup_ < 1.0))
       throw std::invalid_argument("ida-bdf: delta_cj_lsetup must be in (0, 1), got " + std::to_string(dcj_lsetup_));
     resolved_ = s.resolved();
@@ -48,10 +57,7 @@ class IdaBdf final : public SundialsBaseline {
   void create_solver(SemiDiscreteSystem& system, const State& state) override {
     free_ida();
     const Index N = fos_->size();
-    build_block_pattern(*system.pattern());
-    K_.pattern = M_.pattern = G_v_.pattern = system.pattern();
-    K_.values.assign(static_cast<size_t>(system.pattern()->nnz()), 0.0);
-    M_.values = G_v_.values = K_.values;
+    newton_ = std::make_unique<SecondOrderNewton>(system.pattern(), system.dofs(), linear_solver_);
     fext_.resize(n_);
     cv_.resize(n_);
     y_ = make_serial_vector(N, *ctx_);
@@ -59,8 +65,9 @@ class IdaBdf final : public SundialsBaseline {
     id_ = make_serial_vector(N, *ctx_);
     write_y(state);
     N_VConst(1.0, id_.get());
-    J_ = make_csc_matrix(*big_.pattern, *ctx_);
-    LS_.reset(make_sun_linear_solver(*ctx_, make_linear_solver(linear_solver_)));
+    J_ = make_placeholder_matrix(*ctx_);
+    LS_ = make_callback_linear_solver(*ctx_, {[this] { return ls_setup(); },
+                                              [this](const double* b, double* x) { return ls_solve(b, x); }});
 
     mem_ = IDACreate(*ctx_);
     check_ptr(mem_, "IDACreate");
@@ -94,7 +101,7 @@ class IdaBdf final : public SundialsBaseline {
   void unpack(State& s) override { read_y(s); }
   bool acceleration_in_y() const override { return true; }
   void rebase_counters() override { base_ = IdaCounters{}; }
-  long factorizations() const override { return sun_linear_solver_backend(LS_.get()).stats().factorizations; }
+  long factorizations() const override { return newton_ ? newton_->backend().stats().factorizations : 0; }
   double last_step() const override {
     double h = 0;
     IDAGetLastStep(mem_, &h);
@@ -151,8 +158,6 @@ class IdaBdf final : public SundialsBaseline {
     if (!what.empty()) os << ": " << what;
     if (!sundials_message_.empty()) os << "; " << sundials_message_;
     if (errors_.has_error()) os << "; " << errors_.message();
-    const std::string& ls = sun_linear_solver_last_error(LS_.get());
-    if (!ls.empty()) os << "; " << ls;
     throw StepFailure(os.str());
   }
 
@@ -163,38 +168,12 @@ class IdaBdf final : public SundialsBaseline {
     mem_ = nullptr;
   }
 
-  // --- Jacobian pattern: columns [q (n) | v (n) | w (1) | d (1)], rows likewise ---
-  void build_block_pattern(const SparsePattern& P) {
-    auto big = std::make_shared<SparsePattern>();
-    const Index n = P.n, N = 2 * n + 2;
-    big->n = N;
-    big->colptr.reserve(static_cast<size_t>(N) + 1);
-    big->colptr.push_back(0);
-    auto& rows = big->rowind;
-    for (Index j = 0; j < n; ++j) {  // q columns: (j, j) then the K rows
-      rows.push_back(j);
-      for (Index k = P.colptr[j]; k < P.colptr[j + 1]; ++k) rows.push_back(n + P.rowind[k]);
-      big->colptr.push_back(static_cast<Index>(rows.size()));
-    }
-    for (Index j = 0; j < n; ++j) {  // v columns: (j, n+j) = −1, the M rows, then the w and d rows
-      rows.push_back(j);
-      for (Index k = P.colptr[j]; k < P.colptr[j + 1]; ++k) rows.push_back(n + P.rowind[k]);
-      rows.push_back(2 * n);
-      rows.push_back(2 * n + 1);
-      big->colptr.push_back(static_cast<Index>(rows.size()));
-    }
-    rows.push_back(2 * n);  // w column
-    big->colptr.push_back(static_cast<Index>(rows.size()));
-    rows.push_back(2 * n + 1);  // d column
-    big->colptr.push_back(static_cast<Index>(rows.size()));
-    big_.pattern = big;
-    big_.values.assign(rows.size(), 0.0);
-  }
-
-  // Forward differences of h(q, v) = M(q) v̇ + F_m(q, v): G_q += ∂h/∂q into K_, G_v = ∂F_m/∂v.
+  // Forward differences of h(q, v) = M(q) v̇ + F_m(q, v): ∂h/∂q added to K, G = ∂F_m/∂v.
   void add_fd_inertia(const State& s, const Eigen::VectorXd& a) {
-    const SparsePattern& P = *K_.pattern;
-    SparseMatrix Mp{K_.pattern, std::vector<double>(K_.values.size())};
+    SparseMatrix& K = newton_->K;
+    SparseMatrix& G = newton_->G;
+    const SparsePattern& P = *K.pattern;
+    SparseMatrix Mp{K.pattern, std::vector<double>(K.values.size())};
     Eigen::VectorXd h0(n_), hp(n_), fm(n_);
     auto h = [&](const Eigen::VectorXd& u, const Eigen::VectorXd& v, Eigen::VectorXd& out) {
       sys_->mass(u, s.charts, Mp);
@@ -209,12 +188,12 @@ class IdaBdf final : public SundialsBaseline {
       u[j] += eq;
       h(u, s.v, hp);
       u[j] = s.u[j];
-      for (Index k = P.colptr[j]; k < P.colptr[j + 1]; ++k) K_.values[k] += (hp[P.rowind[k]] - h0[P.rowind[k]]) / eq;
+      for (Index k = P.colptr[j]; k < P.colptr[j + 1]; ++k) K.values[k] += (hp[P.rowind[k]] - h0[P.rowind[k]]) / eq;
       const double ev = 1e-7 * std::max(1.0, std::abs(v[j]));
       v[j] += ev;
       h(s.u, v, hp);
       v[j] = s.v[j];
-      for (Index k = P.colptr[j]; k < P.colptr[j + 1]; ++k) G_v_.values[k] = (hp[P.rowind[k]] - h0[P.rowind[k]]) / ev;
+      for (Index k = P.colptr[j]; k < P.colptr[j + 1]; ++k) G.values[k] = (hp[P.rowind[k]] - h0[P.rowind[k]]) / ev;
     }
   }
 
@@ -244,7 +223,11 @@ class IdaBdf final : public SundialsBaseline {
     }
   }
 
-  static int jacobian(sunrealtype t, sunrealtype cj, N_Vector y, N_Vector yp, N_Vector, SUNMatrix J, void* ud,
+  // Assembles the blocks of the Newton matrix J = ∂F/∂y + c_j ∂F/∂ẏ (rows q, v, w, d):
+  //   [[c_j I, −I], [K, c_j M + G]] on (q, v), and the w and d rows c_j x_w − F_ext·x_v, c_j x_d − 2 (C v)·x_v;
+  // ls_setup() factorizes its Schur complement, ls_solve() eliminates (docs/theory/baseline-newton.md §3).
+  // The placeholder J is not written.
+  static int jacobian(sunrealtype t, sunrealtype cj, N_Vector y, N_Vector yp, N_Vector, SUNMatrix, void* ud,
                       N_Vector, N_Vector, N_Vector) {
     auto* self = static_cast<IdaBdf*>(ud);
     try {
@@ -254,52 +237,59 @@ class IdaBdf final : public SundialsBaseline {
       self->fos_->unpack(yv, s);
       self->a_ = Eigen::Map<const Eigen::VectorXd>(N_VGetArrayPointer(yp) + n, n);
       const SemiDiscreteSystem& sys = *self->sys_;
-      sys.internal(s.u, s.charts, nullptr, &self->K_);
-      sys.add_load_stiffness(t, s.u, s.charts, self->K_);
-      sys.mass(s.u, s.charts, self->M_);
+      SecondOrderNewton& nw = *self->newton_;
+      sys.internal(s.u, s.charts, nullptr, &nw.K);
+      sys.add_load_stiffness(t, s.u, s.charts, nw.K);
+      sys.mass(s.u, s.charts, nw.M);
       sys.external(t, s.u, s.charts, self->fext_.data());
-      self->G_v_.set_zero();
+      nw.G.set_zero();
       // ∂F_m/∂v: the damping matrix C (docs/theory.md §8.5) in the approximate Jacobian; fd-inertia
       // differentiates F_m, which contains C v, so it has C already.
       if (self->jacobian_ == "fd-inertia")
         self->add_fd_inertia(s, self->a_);
       else
-        sys.add_damping_matrix(1.0, self->G_v_);
+        sys.add_damping_matrix(1.0, nw.G);
       if (sys.has_damping())
         sys.damping_force(s.v, self->cv_.data());
       else
         self->cv_.setZero();
-
-      const SparsePattern& P = *self->K_.pattern;
-      const DofMap& dofs = sys.dofs();
-      const Index* bcol = self->big_.pattern->colptr.data();
-      double* val = self->big_.values.data();
-      for (Index j = 0; j < n; ++j) {
-        Index pq = bcol[j], pv = bcol[n + j];
-        val[pq++] = cj;
-        val[pv++] = -1.0;
-        for (Index k = P.colptr[j]; k < P.colptr[j + 1]; ++k, ++pq, ++pv) {
-          const Index row = P.rowind[k];
-          if (dofs.is_constrained(row)) {  // momentum row replaced by v̇_c = 0
-            val[pq] = 0.0;
-            val[pv] = row == j ? cj : 0.0;
-          } else {
-            val[pq] = self->K_.values[k];
-            val[pv] = cj * self->M_.values[k] + self->G_v_.values[k];
-          }
-        }
-        val[pv++] = -self->fext_[j];         // ∂(ẇ − F_ext·v)/∂v_j
-        val[pv] = -2.0 * self->cv_[j];       // ∂(ḋ − vᵀ C v)/∂v_j (C symmetric)
-      }
-      val[bcol[2 * n]] = cj;
-      val[bcol[2 * n + 1]] = cj;
-      copy_to_sun_matrix(self->big_, J);  // IDA zeroed J, structure included (docs/dependencies.md §3.2)
+      self->cj_ = cj;
       return 0;
     } catch (const std::domain_error&) {
       return 1;
     } catch (...) {
       self->errors_.capture("ida-bdf Jacobian");
       return -1;
+    }
+  }
+
+  int ls_setup() {
+    try {
+      newton_->factorize(1.0 / cj_);
+      return SUNLS_SUCCESS;
+    } catch (...) {
+      errors_.capture("ida-bdf Newton-matrix factorization");
+      return SUNLS_PACKAGE_FAIL_REC;  // IDA cuts the step and retries
+    }
+  }
+
+  // J x = b with the c_j of the last factorization (IDA rescales x for a changed c_j itself). With γ = 1/c_j the
+  // (q, v) rows are the block system of second_order_newton.hpp with r_q = γ b_q, p = γ b_v (constrained rows:
+  // c_j x_v,c = b_v,c); then x_w = (b_w + F_ext·x_v)/c_j and x_d = (b_d + 2 (C v)·x_v)/c_j.
+  int ls_solve(const double* b, double* x) {
+    try {
+      const Index n = n_;
+      const double g = newton_->gamma();
+      rq_ = g * Eigen::Map<const Eigen::VectorXd>(b, n);
+      p_ = g * Eigen::Map<const Eigen::VectorXd>(b + n, n);
+      newton_->solve(rq_.data(), nullptr, p_.data(), x, x + n);
+      const Eigen::Map<const Eigen::VectorXd> xv(x + n, n);
+      x[2 * n] = g * (b[2 * n] + fext_.dot(xv));
+      x[2 * n + 1] = g * (b[2 * n + 1] + 2.0 * cv_.dot(xv));
+      return all_finite(x, 2 * n + 2) ? SUNLS_SUCCESS : SUNLS_PACKAGE_FAIL_REC;  // non-finite: cut the step
+    } catch (...) {
+      errors_.capture("ida-bdf Newton solve");
+      return SUNLS_PACKAGE_FAIL_UNREC;
     }
   }
 
@@ -325,8 +315,9 @@ class IdaBdf final : public SundialsBaseline {
   SunLinearSolverPtr LS_;
   void* mem_ = nullptr;
 
-  Eigen::VectorXd a_, r_, fext_, cv_;
-  SparseMatrix K_, M_, G_v_, big_;
+  std::unique_ptr<SecondOrderNewton> newton_;
+  double cj_ = 1.0;
+  Eigen::VectorXd a_, r_, fext_, cv_, rq_, p_;
   IdaCounters base_;
 };
 

@@ -7,7 +7,7 @@
 // M(q) is handled exactly (ARKStep cannot: docs/dependencies.md §4.5). Constrained DOFs c keep q̇_c − v_c = 0 and
 // replace their momentum row by v̇_c = 0, so every component is differential (IDASetId all ones).
 //
-// Newton matrix ∂F/∂y + c_j ∂F/∂ẏ on a block CSC pattern built once from pattern() (2n + 2 unknowns):
+// Newton matrix ∂F/∂y + c_j ∂F/∂ẏ (2n + 2 unknowns):
 //
 //     [ c_j I                      −I                   0     0  ]
 //     [ K − K_load  (+ G_q)        c_j M + C  (+ G_v)    0     0  ]      constrained momentum rows: c_j e_cᵀ
@@ -21,8 +21,14 @@
 // iterations) but does not change the solution. `jacobian: fd-inertia` adds G_q and G_v by forward
 // differences of the Model's mass()/inertial() (2n evaluations per Jacobian: for measurements only;
 // see tests/integrators/test_ida_bdf.cpp and benchmarks/bench_sundials_baselines.cpp for the cost).
-// Linear solver: the project's custom SUNLinearSolver with KLU (AMD, one analysis per run); the
-// iteration matrix is not symmetric, so the one-triangle back-ends are rejected.
+//
+// Linear solves: the matrix is never formed. IDA gets a placeholder matrix and a callback solver
+// (integrators/sundials/callback_linear_solver.hpp); the Jacobian callback assembles K, M, C (or G_v), F_ext
+// and C v, and the solver eliminates the velocity block (integrators/baselines/second_order_newton.hpp,
+// docs/theory/baseline-newton.md §3): it factorizes the n × n Schur complement c_j² M + c_j (C + G_v) + K and
+// recovers x_v, x_w and x_d from it exactly. With the approximate Jacobian the Schur complement is symmetric:
+// linear_solver cholmod (default), eigen-ldlt, mumps or klu; fd-inertia's is not, and needs klu (its default).
+// Until this change ida-bdf factorized the (2n+2)² matrix with KLU, about half of its run time.
 //
 // Consistent initial ẏ: computed directly, v̇₀ = M(q₀)⁻¹(F_ext − F_int − F_m) with a mass-matrix
 // factorization (exact; no IDACalcIC Newton solve). After a chart switch the Model converts (q, v, v̇)
@@ -42,7 +48,8 @@
 //
 // Settings (plus the common ones of sundials_baseline.hpp: rtol, atol, length_scale, time_scale, max_step,
 // init_step, max_steps, chart_overshoot, mass_solver (initial acceleration), mass_reuse, progress_every):
-// max_order [2]; linear_solver [klu]; jacobian: approximate|fd-inertia [approximate]; delta_cj_lsetup [0.25].
+// max_order [2]; linear_solver [cholmod; klu with fd-inertia]; jacobian: approximate|fd-inertia [approximate];
+// delta_cj_lsetup [0.25].
 #pragma once
 
 #include "integrators/integrator.hpp"

@@ -90,7 +90,11 @@ TEST(IdaBdf, SettingsErrorsAreClear) {
   };
   EXPECT_NE(msg({{"rtol", "-1"}}).find("ida-bdf: rtol must be in (0, 1), got -1"), std::string::npos);
   EXPECT_NE(msg({{"atol", "-1"}}).find("atol must be >= 0"), std::string::npos);  // 0 = rtol/100 (automatic)
-  EXPECT_NE(msg({{"linear_solver", "cholmod"}}).find("not symmetric"), std::string::npos);
+  EXPECT_EQ(msg({{"linear_solver", "cholmod"}}), "no error");  // the Schur complement is symmetric
+  EXPECT_NE(msg({{"linear_solver", "superlu"}}).find("unknown linear_solver 'superlu'"), std::string::npos);
+  EXPECT_NE(msg({{"jacobian", "fd-inertia"}, {"linear_solver", "cholmod"}}).find("use linear_solver=klu"),
+            std::string::npos);
+  EXPECT_EQ(msg({{"jacobian", "fd-inertia"}}), "no error");  // defaults to klu
   EXPECT_NE(msg({{"max_order", "7"}}).find("max_order must be 1..5"), std::string::npos);
   EXPECT_NE(msg({{"jacobian", "exact"}}).find("jacobian must be"), std::string::npos);
   EXPECT_NE(msg({{"rtoll", "1e-6"}}), "no error");  // unknown key rejected by finish()
