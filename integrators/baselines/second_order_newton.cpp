@@ -2,6 +2,7 @@
 
 #include "lib/assembler.hpp"
 
+#include <algorithm>
 #include <stdexcept>
 
 namespace shelldyn {
@@ -25,6 +26,8 @@ void SecondOrderNewton::factorize(double gamma) {
   const double g2 = gamma * gamma;
   for (size_t k = 0; k < S_.values.size(); ++k) S_.values[k] = M.values[k] + gamma * G.values[k] + g2 * K.values[k];
   apply_dirichlet(dofs_, S_, nullptr, 1.0);
+  // An undamped model with the approximate Jacobian has G = 0: skip its product in every solve.
+  g_zero_ = std::all_of(G.values.begin(), G.values.end(), [](double v) { return v == 0.0; });
   gamma_ = 0.0;
   solver_->factorize(S_.view());
   gamma_ = gamma;
@@ -48,8 +51,10 @@ void SecondOrderNewton::solve(const double* r_q, const double* m, const double* 
   else
     tmp_ = z_;
   multiply(M.view(), tmp_.data(), rhs_.data());
-  multiply(G.view(), z_.data(), tmp_.data());
-  rhs_ += g * tmp_;
+  if (!g_zero_) {
+    multiply(G.view(), z_.data(), tmp_.data());
+    rhs_ += g * tmp_;
+  }
   if (p) rhs_ += g * Eigen::Map<const Eigen::VectorXd>(p, n);
   if (dofs_.num_constrained() > 0) {
     multiply(K.view(), xc_.data(), tmp_.data());

@@ -53,6 +53,7 @@ class SecondOrderNewton {
   std::unique_ptr<LinearSolver> solver_;
   SparseMatrix S_;
   double gamma_ = 0.0;
+  bool g_zero_ = false;  // G was all zeros at the last factorize()
   Eigen::VectorXd z_, xc_, rhs_, tmp_;
 };
 
