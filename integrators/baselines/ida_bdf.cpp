@@ -32,6 +32,7 @@ class IdaBdf final : public SundialsBaseline {
     // fd-inertia's G and K are not symmetric and need an LU.
     linear_solver_ = s.get("linear_solver", jacobian_ == "fd-inertia" ? "klu" : "cholmod");
     dcj_lsetup_ = s.get("delta_cj_lsetup", 0.25);
+    jacobian_reuse_ = s.get("jacobian_reuse", 20);
     if (max_order_ < 1 || max_order_ > 5)
       throw std::invalid_argument("ida-bdf: max_order must be 1..5, got " + std::to_string(max_order_));
     if (jacobian_ != "approximate" && jacobian_ != "fd-inertia")
@@ -45,6 +46,9 @@ class IdaBdf final : public SundialsBaseline {
     if (jacobian_ == "fd-inertia" && linear_solver_ != "klu")
       throw std::invalid_argument("ida-bdf: jacobian=fd-inertia gives a non-symmetric Newton matrix; linear_solver '" +
                                   linear_solver_ + "' factors symmetric matrices only, use linear_solver=klu");
+    if (jacobian_reuse_ < 0)
+      throw std::invalid_argument("ida-bdf: jacobian_reuse must be >= 0 steps (0: assemble at every Newton-matrix "
+                                  "setup), got " + std::to_string(jacobian_reuse_));
     if (!(dcj_lsetup_ > 0.0 && dcj_lsetup_ < 1.0))
       throw std::invalid_argument("ida-bdf: delta_cj_lsetup must be in (0, 1), got " + std::to_string(dcj_lsetup_));
     resolved_ = s.resolved();
@@ -88,6 +92,7 @@ class IdaBdf final : public SundialsBaseline {
     check(IDASetRootDirection(mem_, &direction), "IDASetRootDirection");
     check(IDASetNoInactiveRootWarn(mem_), "IDASetNoInactiveRootWarn");
     base_ = IdaCounters{};
+    blocks_valid_ = false;
   }
   void set_stop_time(double t_out) override { check(IDASetStopTime(mem_, t_out), "IDASetStopTime"); }
   int one_step(double t_out, double& tret) override {
@@ -97,7 +102,10 @@ class IdaBdf final : public SundialsBaseline {
     return flag == IDA_ROOT_RETURN ? StepOutcome::root : flag == IDA_TSTOP_RETURN ? StepOutcome::reached : StepOutcome::step;
   }
   void pack(const State& s) override { write_y(s, data(yp_.get())[fos_->work_index()]); }
-  void reinit() override { check(IDAReInit(mem_, t_, y_.get(), yp_.get()), "IDAReInit"); }
+  void reinit() override {
+    check(IDAReInit(mem_, t_, y_.get(), yp_.get()), "IDAReInit");
+    blocks_valid_ = false;  // a chart switch changes what the unknowns mean
+  }
   void unpack(State& s) override { read_y(s); }
   bool acceleration_in_y() const override { return true; }
   void rebase_counters() override { base_ = IdaCounters{}; }
@@ -231,6 +239,8 @@ class IdaBdf final : public SundialsBaseline {
                       N_Vector, N_Vector, N_Vector) {
     auto* self = static_cast<IdaBdf*>(ud);
     try {
+      self->cj_ = cj;
+      if (self->reuse_blocks()) return 0;  // only c_j changed enough for a new setup: refactorize, keep K, M, G
       const Index n = self->n_;
       const double* yv = N_VGetArrayPointer(y);
       State& s = self->work_;
@@ -253,7 +263,7 @@ class IdaBdf final : public SundialsBaseline {
         sys.damping_force(s.v, self->cv_.data());
       else
         self->cv_.setZero();
-      self->cj_ = cj;
+      self->blocks_valid_ = true;
       return 0;
     } catch (const std::domain_error&) {
       return 1;
@@ -261,6 +271,25 @@ class IdaBdf final : public SundialsBaseline {
       self->errors_.capture("ida-bdf Jacobian");
       return -1;
     }
+  }
+
+  // IDA asks for a new Newton matrix after a convergence failure and whenever c_j has changed by more than
+  // delta_cj_lsetup, which with error-test rejections is nearly every step. The blocks K, M, G, F_ext and C v do
+  // not depend on c_j, so they are re-assembled only after a convergence failure, after jacobian_reuse steps, or
+  // after a re-initialization (chart switch); otherwise the setup only refactorizes S at the new c_j. A stale block
+  // makes the Newton matrix approximate, never the residual, so the solution is unchanged (IDA's convergence test
+  // decides, as for its own stale Jacobians).
+  bool reuse_blocks() {
+    long steps = 0, conv_fails = 0;
+    IDAGetNumSteps(mem_, &steps);
+    IDAGetNumNonlinSolvConvFails(mem_, &conv_fails);
+    const bool reuse = blocks_valid_ && jacobian_reuse_ > 0 && conv_fails == assembled_conv_fails_ &&
+                       steps - assembled_steps_ < jacobian_reuse_;
+    if (!reuse) {
+      assembled_steps_ = steps;
+      assembled_conv_fails_ = conv_fails;
+    }
+    return reuse;
   }
 
   int ls_setup() {
@@ -305,7 +334,7 @@ class IdaBdf final : public SundialsBaseline {
   }
 
   // settings
-  int max_order_;
+  int max_order_, jacobian_reuse_;
   double dcj_lsetup_;
   std::string linear_solver_, jacobian_;
 
@@ -317,6 +346,8 @@ class IdaBdf final : public SundialsBaseline {
 
   std::unique_ptr<SecondOrderNewton> newton_;
   double cj_ = 1.0;
+  bool blocks_valid_ = false;
+  long assembled_steps_ = 0, assembled_conv_fails_ = 0;
   Eigen::VectorXd a_, r_, fext_, cv_, rq_, p_;
   IdaCounters base_;
 };

@@ -49,7 +49,8 @@
 // Settings (plus the common ones of sundials_baseline.hpp: rtol, atol, length_scale, time_scale, max_step,
 // init_step, max_steps, chart_overshoot, mass_solver (initial acceleration), mass_reuse, progress_every):
 // max_order [2]; linear_solver [cholmod; klu with fd-inertia]; jacobian: approximate|fd-inertia [approximate];
-// delta_cj_lsetup [0.25].
+// delta_cj_lsetup [0.25]; jacobian_reuse [20]: steps for which the assembled blocks K, M, G are reused by
+// Newton-matrix setups that only follow a change of c_j (0: assemble at every setup, IDA's own behaviour).
 #pragma once
 
 #include "integrators/integrator.hpp"

@@ -95,6 +95,7 @@ TEST(IdaBdf, SettingsErrorsAreClear) {
   EXPECT_NE(msg({{"jacobian", "fd-inertia"}, {"linear_solver", "cholmod"}}).find("use linear_solver=klu"),
             std::string::npos);
   EXPECT_EQ(msg({{"jacobian", "fd-inertia"}}), "no error");  // defaults to klu
+  EXPECT_NE(msg({{"jacobian_reuse", "-1"}}).find("jacobian_reuse must be >= 0"), std::string::npos);
   EXPECT_NE(msg({{"max_order", "7"}}).find("max_order must be 1..5"), std::string::npos);
   EXPECT_NE(msg({{"jacobian", "exact"}}).find("jacobian must be"), std::string::npos);
   EXPECT_NE(msg({{"rtoll", "1e-6"}}), "no error");  // unknown key rejected by finish()
