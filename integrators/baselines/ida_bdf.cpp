@@ -92,7 +92,7 @@ class IdaBdf final : public SundialsBaseline {
     check(IDASetRootDirection(mem_, &direction), "IDASetRootDirection");
     check(IDASetNoInactiveRootWarn(mem_), "IDASetNoInactiveRootWarn");
     base_ = IdaCounters{};
-    blocks_valid_ = false;
+    invalidate_blocks();
   }
   void set_stop_time(double t_out) override { check(IDASetStopTime(mem_, t_out), "IDASetStopTime"); }
   int one_step(double t_out, double& tret) override {
@@ -104,7 +104,7 @@ class IdaBdf final : public SundialsBaseline {
   void pack(const State& s) override { write_y(s, data(yp_.get())[fos_->work_index()]); }
   void reinit() override {
     check(IDAReInit(mem_, t_, y_.get(), yp_.get()), "IDAReInit");
-    blocks_valid_ = false;  // a chart switch changes what the unknowns mean
+    invalidate_blocks();  // a chart switch changes what the unknowns mean; IDA's counters restart at 0
   }
   void unpack(State& s) override { read_y(s); }
   bool acceleration_in_y() const override { return true; }
@@ -275,15 +275,27 @@ class IdaBdf final : public SundialsBaseline {
 
   // IDA asks for a new Newton matrix after a convergence failure and whenever c_j has changed by more than
   // delta_cj_lsetup, which with error-test rejections is nearly every step. The blocks K, M, G, F_ext and C v do
-  // not depend on c_j, so they are re-assembled only after a convergence failure, after jacobian_reuse steps, or
-  // after a re-initialization (chart switch); otherwise the setup only refactorizes S at the new c_j. A stale block
-  // makes the Newton matrix approximate, never the residual, so the solution is unchanged (IDA's convergence test
-  // decides, as for its own stale Jacobians).
+  // not depend on c_j, so they are re-assembled only when the Jacobian may be bad: a second request within the same
+  // step attempt (IDA's Newton retrying after slow convergence with a stale matrix: neither the step count nor a
+  // failure count has moved since the last request), a convergence failure since the last assembly, jacobian_reuse
+  // steps since it, or a re-initialization (chart switch). Otherwise the setup only refactorizes S at the new c_j.
+  // A stale block makes the Newton matrix approximate, never the residual, so the solution is unchanged (IDA's
+  // convergence test decides, as for its own stale Jacobians). docs/theory/baseline-newton.md §3.
+  void invalidate_blocks() {
+    blocks_valid_ = false;
+    request_steps_ = request_conv_fails_ = request_err_fails_ = -1;
+  }
+
   bool reuse_blocks() {
-    long steps = 0, conv_fails = 0;
+    long steps = 0, conv_fails = 0, err_fails = 0;
     IDAGetNumSteps(mem_, &steps);
     IDAGetNumNonlinSolvConvFails(mem_, &conv_fails);
-    const bool reuse = blocks_valid_ && jacobian_reuse_ > 0 && conv_fails == assembled_conv_fails_ &&
+    IDAGetNumErrTestFails(mem_, &err_fails);
+    const bool retry = steps == request_steps_ && conv_fails == request_conv_fails_ && err_fails == request_err_fails_;
+    request_steps_ = steps;
+    request_conv_fails_ = conv_fails;
+    request_err_fails_ = err_fails;
+    const bool reuse = blocks_valid_ && jacobian_reuse_ > 0 && !retry && conv_fails == assembled_conv_fails_ &&
                        steps - assembled_steps_ < jacobian_reuse_;
     if (!reuse) {
       assembled_steps_ = steps;
@@ -347,7 +359,8 @@ class IdaBdf final : public SundialsBaseline {
   std::unique_ptr<SecondOrderNewton> newton_;
   double cj_ = 1.0;
   bool blocks_valid_ = false;
-  long assembled_steps_ = 0, assembled_conv_fails_ = 0;
+  long assembled_steps_ = 0, assembled_conv_fails_ = 0;                     // at the last assembly
+  long request_steps_ = -1, request_conv_fails_ = -1, request_err_fails_ = -1;  // at the last Jacobian request
   Eigen::VectorXd a_, r_, fext_, cv_, rq_, p_;
   IdaCounters base_;
 };
