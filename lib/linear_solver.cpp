@@ -667,6 +667,11 @@ void check_csc_pattern(const CscView& A, const std::string& who) {
 
 std::vector<std::string> linear_solver_names() { return {"cholmod", "eigen-ldlt", "klu", "mumps"}; }
 
+bool is_linear_solver_name(const std::string& name) {
+  const auto names = linear_solver_names();
+  return std::find(names.begin(), names.end(), name) != names.end();
+}
+
 std::unique_ptr<LinearSolver> make_linear_solver(const std::string& name) {
   if (name == "cholmod") return std::make_unique<CholmodSolver>();
   if (name == "eigen-ldlt") return std::make_unique<EigenLdltSolver>();

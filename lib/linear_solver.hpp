@@ -1,13 +1,13 @@
-// Sparse direct solvers for the symmetric systems of the project (tangents K̄, mass matrices, IDA and
-// ARKODE iteration matrices), behind one small interface: analyse once per pattern, factorize per
+// Sparse direct solvers for the systems of the project (tangents K̄, mass matrices, the Schur complements of
+// the IDA and ARKODE Newton matrices, integrators/baselines/second_order_newton.hpp), behind one small interface: analyse once per pattern, factorize per
 // Newton setup, solve per iteration (architecture.md §4.4, docs/dependencies.md §5).
 //
 // Input contract (lib/sparse_matrix.hpp): square CSC with 64-bit indices, FULL storage (both
 // triangles), row indices sorted within each column, no duplicates. Each back-end reads what it
 // needs directly from that storage ("mumps" keeps its own 1-based copy of one triangle's indices).
 // "cholmod", "eigen-ldlt" and "mumps" read one triangle and therefore assume symmetric values;
-// "klu" factors the full storage and also works for non-symmetric matrices (e.g. IDA/ARKODE
-// iteration matrices of first-order systems).
+// "klu" factors the full storage and also works for non-symmetric matrices (e.g. ida-bdf's Schur complement
+// with jacobian=fd-inertia, or unsymmetric load tangents in statics).
 //   - "cholmod":    CHOLMOD (cholmod_l_*), upper triangle (stype = +1), AMD ordering, supernodal LLᵀ.
 //                   If the matrix is not positive definite (CHOLMOD_NOT_POSDEF), the solver switches
 //                   PERMANENTLY to simplicial LDLᵀ (re-analysis once; visible as an extra count in
@@ -91,6 +91,8 @@ class LinearSolver {
 // "cholmod" | "eigen-ldlt" | "klu" | "mumps"; anything else throws std::invalid_argument listing valid names.
 std::unique_ptr<LinearSolver> make_linear_solver(const std::string& name);
 std::vector<std::string> linear_solver_names();
+// True if make_linear_solver(name) knows the name (lets callers validate settings before building a solver).
+bool is_linear_solver_name(const std::string& name);
 
 // Structural checks shared by the back-ends (and useful to callers): n > 0, colptr[0] == 0,
 // non-decreasing colptr, row indices in [0, n) and strictly increasing within each column.

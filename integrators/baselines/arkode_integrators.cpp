@@ -39,8 +39,7 @@ class ArkodeIntegrator final : public SundialsBaseline {
     if (fixed_ && !(dt_ > 0.0 && std::isfinite(dt_)))
       throw std::invalid_argument(name_ + ": fixed_step needs a positive time step dt, got " + std::to_string(dt_));
     if (implicit) {
-      const auto names = linear_solver_names();
-      if (std::find(names.begin(), names.end(), linear_solver_) == names.end())
+      if (!is_linear_solver_name(linear_solver_))
         throw std::invalid_argument(name_ + ": unknown linear_solver '" + linear_solver_ +
                                     "' (M + gamma^2 K is symmetric: eigen-ldlt, cholmod, mumps or klu)");
       if (lsetup_frequency_ < 0) throw std::invalid_argument(name_ + ": lsetup_frequency must be >= 0 (0 = ARKODE default 20)");

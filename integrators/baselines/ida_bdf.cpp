@@ -38,8 +38,7 @@ class IdaBdf final : public SundialsBaseline {
     if (jacobian_ != "approximate" && jacobian_ != "fd-inertia")
       throw std::invalid_argument("ida-bdf: jacobian must be 'approximate' or 'fd-inertia', got '" + jacobian_ +
                                   "'");
-    const auto names = linear_solver_names();
-    if (std::find(names.begin(), names.end(), linear_solver_) == names.end())
+    if (!is_linear_solver_name(linear_solver_))
       throw std::invalid_argument("ida-bdf: unknown linear_solver '" + linear_solver_ +
                                   "' (the Newton matrix's Schur complement is symmetric: cholmod, eigen-ldlt, mumps or "
                                   "klu)");
@@ -279,8 +278,9 @@ class IdaBdf final : public SundialsBaseline {
   // step attempt (IDA's Newton retrying after slow convergence with a stale matrix: neither the step count nor a
   // failure count has moved since the last request), a convergence failure since the last assembly, jacobian_reuse
   // steps since it, or a re-initialization (chart switch). Otherwise the setup only refactorizes S at the new c_j.
-  // A stale block makes the Newton matrix approximate, never the residual, so the solution is unchanged (IDA's
-  // convergence test decides, as for its own stale Jacobians). docs/theory/baseline-newton.md §3.
+  // A stale block makes the Newton matrix approximate, never the residual: every accepted step satisfies the same
+  // equations to the same tolerance; only the Newton contraction and, through round-off, the step sequence can
+  // change (IDA's convergence test decides, as for its own stale Jacobians). docs/theory/baseline-newton.md §3.
   void invalidate_blocks() {
     blocks_valid_ = false;
     request_steps_ = request_conv_fails_ = request_err_fails_ = -1;

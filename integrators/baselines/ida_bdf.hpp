@@ -28,7 +28,7 @@
 // docs/theory/baseline-newton.md §3): it factorizes the n × n Schur complement c_j² M + c_j (C + G_v) + K and
 // recovers x_v, x_w and x_d from it exactly. With the approximate Jacobian the Schur complement is symmetric:
 // linear_solver cholmod (default), eigen-ldlt, mumps or klu; fd-inertia's is not, and needs klu (its default).
-// Until this change ida-bdf factorized the (2n+2)² matrix with KLU, about half of its run time.
+// (Before 2026-11-29 ida-bdf factorized the (2n+2)² matrix with KLU: about half of its run time, docs/results.md §7.2.)
 //
 // Consistent initial ẏ: computed directly, v̇₀ = M(q₀)⁻¹(F_ext − F_int − F_m) with a mass-matrix
 // factorization (exact; no IDACalcIC Newton solve). After a chart switch the Model converts (q, v, v̇)

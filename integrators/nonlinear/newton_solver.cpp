@@ -54,9 +54,7 @@ void validate(const NewtonOptions& o) {
   if (!(o.energy_floor >= 0)) bad("energy_floor must be >= 0");
   if (!(o.refresh_contraction >= 0) || !std::isfinite(o.refresh_contraction))
     bad("refresh_contraction must be >= 0 (0 = off), got " + std::to_string(o.refresh_contraction));
-  const auto names = linear_solver_names();
-  if (std::find(names.begin(), names.end(), o.linear_solver) == names.end())
-    make_linear_solver(o.linear_solver);  // throws with the list of valid names
+  if (!is_linear_solver_name(o.linear_solver)) make_linear_solver(o.linear_solver);  // throws with the valid names
 }
 
 }  // namespace

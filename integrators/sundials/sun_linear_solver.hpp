@@ -17,8 +17,9 @@
 // No exception ever crosses the C boundary.
 //
 // Matrix symmetry: "cholmod" and "eigen-ldlt" read one triangle and need symmetric matrices
-// (KINSOL with a symmetric tangent). IDA/ARKODE iteration matrices of first-order systems are not
-// symmetric: use "klu" there.
+// (KINSOL with a symmetric tangent); "klu" also factors non-symmetric ones. (The ida-bdf and arkode-dirk
+// baselines do not use this adapter: they solve their Newton matrices by a Schur complement,
+// integrators/sundials/callback_linear_solver.hpp.)
 #pragma once
 
 #include "integrators/sundials/sundials_support.hpp"
