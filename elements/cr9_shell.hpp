@@ -73,6 +73,7 @@ class CR9Shell {
     Vec45 Kw;                                                  // K_bs w_n (bending + shear force at t_n)
     std::array<Eigen::Vector3d, 9> e;                          // ε_m at t_n per Gauss point
     std::array<std::array<Eigen::Matrix<double, 3, 9>, 3>, 9> tH;  // t_n H_m,c per Gauss point and c
+    double U = 0.0;  // strain energy U(u_n), bitwise internal()'s (the same expressions)
   };
   void step_state(const Vec45& u_n, const Charts& charts, StepState* st) const;
   double algorithmic_internal(const StepState& sn, const Vec45& u_n, const Vec45& u_np1, const Charts& charts,

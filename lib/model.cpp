@@ -431,6 +431,15 @@ void Model::element_energies(const Eigen::VectorXd& u, const std::vector<Directo
   });
 }
 
+void Model::step_energies(const Eigen::VectorXd& u_n, const std::vector<DirectorChart>& charts,
+                          std::vector<double>& U) const {
+  StepCache& cache = *step_cache_;
+  std::lock_guard<std::mutex> lock(cache.mutex);
+  const std::vector<CR9Shell::StepState>& states = step_states(u_n, charts);
+  U.resize(states.size());
+  for (size_t e = 0; e < states.size(); ++e) U[e] = states[e].U;
+}
+
 CR9Shell::Mat45 Model::reference_local_stiffness(int e) const {
   const auto& nodes = mesh_.elements[static_cast<size_t>(e)];
   CR9Shell::Charts ch;

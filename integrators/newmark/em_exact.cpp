@@ -234,7 +234,7 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
     for (int i = 0; i < nn_; ++i) vn_.segment<3>(3 * i) = s.v.segment<3>(DofMap::dof(i, 0));
     wn_ = s.pdot;
     directors(un_, charts, pn_);
-    sys.element_energies(un_, charts, Un_);
+    sys.step_energies(un_, charts, Un_);  // U(u_n) from the step's element state (no extra element pass)
 
     std::vector<double> history;  // scaled residual of every evaluated iterate
     double best = std::numeric_limits<double>::infinity();

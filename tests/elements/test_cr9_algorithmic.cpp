@@ -54,6 +54,28 @@ TEST(CR9Algorithmic, StepStateOverloadIsBitwiseTheSame) {
   }
 }
 
+// StepState::U is U(u_n) by internal()'s expressions, hence bitwise internal()'s energy (Model::step_energies
+// replaces an element pass of internal() by it without changing any result). The state of another
+// configuration has another energy (the test can fail).
+TEST(CR9Algorithmic, StepStateEnergyIsInternalsEnergy) {
+  for (Shape shape : {Shape::Flat, Shape::Distorted, Shape::Cylinder}) {
+    const Geometry g = make_geometry(shape, Facing::Z);
+    const CR9Shell e(g.X0, g.p0, test_material());
+    Charts ch;
+    const Vec45 un = random_state(g, 0.05, 0.6, 31, &ch);
+    std::mt19937 rng(37);
+    std::uniform_real_distribution<double> U(-1.0, 1.0);
+    Vec45 u1 = un;
+    for (int j = 0; j < 45; ++j) u1(j) += 0.01 * U(rng);
+    CR9Shell::StepState sn, s1;
+    e.step_state(un, ch, &sn);
+    e.step_state(u1, ch, &s1);
+    EXPECT_EQ(sn.U, e.internal(un, ch, nullptr, nullptr));
+    EXPECT_EQ(s1.U, e.internal(u1, ch, nullptr, nullptr));
+    EXPECT_GT(std::abs(s1.U - sn.U), 1e-6 * std::abs(sn.U));
+  }
+}
+
 // §6.7(a): with alpha_f = 1/2, xi = 0 the local part is exact (ε quadratic in u_L), but u_L(u_G) is
 // transcendental, so F*·Δu - ΔU = O(Δu³): halving Δu divides the error by ~8.
 TEST(CR9Algorithmic, EnergyBalanceErrorIsThirdOrder) {
