@@ -457,8 +457,10 @@ CR9Shell::Mat45 Model::reference_local_stiffness(int e) const {
 double Model::exact_internal(const Eigen::VectorXd& u_n, const Eigen::VectorXd& u_np1,
                              const std::vector<DirectorChart>& charts, const std::vector<double>& U_n, bool correct,
                              double xi, const std::vector<CR9Shell::Mat45>* k0, double* F, SparseMatrix* K,
-                             std::vector<double>* U_np1, ExactForceInfo* info) const {
+                             std::vector<double>* U_np1, ExactForceInfo* info, const Eigen::VectorXd* p_mid) const {
   if (U_n.size() != elements_.size()) throw std::invalid_argument("Model::exact_internal: U_n needs one entry per element");
+  if (p_mid && p_mid->size() != 3 * static_cast<Index>(mesh_.num_nodes()))
+    throw std::invalid_argument("Model::exact_internal: p_mid needs 3 entries per node");
   if (xi > 0.0 && (!k0 || k0->size() != elements_.size()))
     throw std::invalid_argument("Model::exact_internal: xi > 0 needs the reference local stiffness of every element");
   if (F) std::fill(F, F + num_dofs(), 0.0);
@@ -488,7 +490,9 @@ double Model::exact_internal(const Eigen::VectorXd& u_n, const Eigen::VectorXd& 
       for (size_t a = 0; a < 9; ++a) {
         const Index k = 5 * static_cast<Index>(a);
         xm[a] = mesh_.X[static_cast<size_t>(nodes[a])] + 0.5 * (un.segment<3>(k) + u1.segment<3>(k));
-        pm[a] = 0.5 * (shelldyn::director(un.segment<2>(k + 3), ch[a]) + shelldyn::director(u1.segment<2>(k + 3), ch[a]));
+        pm[a] = p_mid ? Vec3(p_mid->segment<3>(3 * static_cast<Index>(nodes[a])))
+                      : Vec3(0.5 * (shelldyn::director(un.segment<2>(k + 3), ch[a]) +
+                                    shelldyn::director(u1.segment<2>(k + 3), ch[a])));
       }
       R = midpoint_rigid_rows(xm, pm, ch);
     }

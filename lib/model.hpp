@@ -133,10 +133,12 @@ class Model final : public SemiDiscreteSystem {
   // projector, k0 = (*k0)[e]). K (optional): the symmetric tangent with respect to u_mid (K_mid of
   // algorithmic_internal, plus 2ξ G_e so that ½K is its derivative with respect to u_np1).
   // U_np1 (optional) receives the element energies at u_np1. Returns V(u_np1).
+  // p_mid (optional, 3 per node): the nodal midpoint directors ½(p(u_n) + p(u_np1)) in `charts`, if the caller has
+  // them (em-exact's kinematics); they are not recomputed then (the same expression, so the same values).
   double exact_internal(const Eigen::VectorXd& u_n, const Eigen::VectorXd& u_np1, const std::vector<DirectorChart>& charts,
                         const std::vector<double>& U_n, bool correct, double xi,
                         const std::vector<CR9Shell::Mat45>* k0, double* F, SparseMatrix* K,
-                        std::vector<double>* U_np1, ExactForceInfo* info) const;
+                        std::vector<double>* U_np1, ExactForceInfo* info, const Eigen::VectorXd* p_mid = nullptr) const;
   // Dead loads at time t in embedded form: translational forces Fd and director loads g_i = m_i × p_mid,i
   // (3 per node each, overwritten); p_mid holds one 3-vector per node.
   void embedded_external(double t, const Eigen::VectorXd& p_mid, Eigen::VectorXd& Fd, Eigen::VectorXd& g) const;

@@ -245,7 +245,7 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
       const Eigen::Map<const Eigen::VectorXd> u(up, n);
       kinematics(u, charts, h, tmid);
       sys.exact_internal(un_, u, charts, Un_, correction_, xi_, xi_ > 0.0 ? &k0_ : nullptr, fint_.data(), nullptr,
-                         nullptr, &finfo);
+                         nullptr, &finfo, &pmid_);  // p_mid from kinematics() just above
       Eigen::Map<Eigen::VectorXd> r(rp, n);
       double scale = 0.0;
       for (int i = 0; i < nn_; ++i) {
@@ -343,7 +343,7 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
     kinematics(u, charts, h, tmid);
     if (xi_ > 0.0) {
       Model::ExactForceInfo fi;
-      sys.exact_internal(un_, u, charts, Un_, correction_, xi_, &k0_, fint_.data(), nullptr, nullptr, &fi);
+      sys.exact_internal(un_, u, charts, Un_, correction_, xi_, &k0_, fint_.data(), nullptr, nullptr, &fi, &pmid_);
       diag_.dissipation += fi.dissipation;
       diag_.min_step_dissipation = std::min(diag_.min_step_dissipation, fi.dissipation);
       diag_.max_beta_z = std::max(diag_.max_beta_z, fi.max_beta_z);
