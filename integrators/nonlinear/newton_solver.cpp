@@ -174,6 +174,8 @@ NewtonSolver::NewtonSolver(std::shared_ptr<const SparsePattern> pattern, NewtonO
   s.u = make_serial_vector(s.n, s.ctx);
   s.uscale = make_serial_vector(s.n, s.ctx);
   s.fscale = make_serial_vector(s.n, s.ctx);
+  // KINSOL's per-iteration norms and updates on vectorized loops (before KINInit clones its work vectors from u).
+  for (N_Vector v : {s.u.get(), s.uscale.get(), s.fscale.get()}) use_vectorized_ops(v);
   s.J = make_csc_matrix(*pattern, s.ctx);
   s.LS.reset(make_sun_linear_solver(s.ctx, make_linear_solver(s.opt.linear_solver)));
   s.Jwork.pattern = pattern;

@@ -72,6 +72,14 @@ using SunLinearSolverPtr = std::unique_ptr<std::remove_pointer_t<SUNLinearSolver
 NVectorPtr make_serial_vector(Index n, SUNContext ctx, const double* init = nullptr);
 double* data(N_Vector v);  // N_VGetArrayPointer, checked non-null
 
+// Replaces the reductions and element-wise operations of a serial N_Vector (N_VWL2Norm, N_VMaxNorm, N_VMin,
+// N_VDotProd, N_VLinearSum, N_VConst, N_VProd, N_VDiv, N_VScale, N_VAbs, N_VInv) by Eigen's vectorized loops
+// (docs/dependencies.md §3.6). Vectors cloned from v later inherit them (N_VClone copies the operation table), so
+// call it on the template vector before it is given to the package (KINInit, ...). The element-wise operations
+// give the same values as SUNDIALS' (the same IEEE operation per entry, no fused multiply-add in a portable
+// build); reductions differ in the order of summation, i.e. at round-off.
+void use_vectorized_ops(N_Vector v);
+
 // CSC SUNSparseMatrix with capacity pattern.nnz(), structure filled from the pattern.
 SunMatrixPtr make_csc_matrix(const SparsePattern& pattern, SUNContext ctx);
 
