@@ -437,12 +437,15 @@ void CR9Shell::step_state(const Vec45& u_n, const Charts& charts, StepState* st)
       tH0 = t0.lazyProduct(gp_[g].Hm[c]);
       st->e[g](c) = gp_[g].Lm.row(c).dot(v0) + 0.5 * tH0.cwiseProduct(t0).sum();
     }
-  // U(u_n) with internal()'s expressions (½ wᵀ(K_bs w) + membrane()'s Σ_gp ½ dA εᵀ h D1 ε), so bitwise the same.
-  const Vec45 f = Kbs_ * st->w;
+}
+
+double CR9Shell::step_energy(const StepState& st) const {
+  // internal()'s expressions: U = ½ wᵀ(K_bs w), then membrane()'s Σ_gp ½ dA εᵀ h D1 ε with the same ε.
+  const Vec45 f = Kbs_ * st.w;
   const Eigen::Matrix3d hD1 = mat_.thickness * D1_;
   double Um = 0.0;
-  for (size_t g = 0; g < gp_.size(); ++g) Um += 0.5 * gp_[g].dA * st->e[g].dot(hD1 * st->e[g]);
-  st->U = 0.5 * st->w.dot(f) + Um;
+  for (size_t g = 0; g < gp_.size(); ++g) Um += 0.5 * gp_[g].dA * st.e[g].dot(hD1 * st.e[g]);
+  return 0.5 * st.w.dot(f) + Um;
 }
 
 double CR9Shell::algorithmic_internal(const StepState& sn, const Vec45& u_n, const Vec45& u_np1, const Charts& charts,

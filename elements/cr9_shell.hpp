@@ -73,9 +73,11 @@ class CR9Shell {
     Vec45 Kw;                                                  // K_bs w_n (bending + shear force at t_n)
     std::array<Eigen::Vector3d, 9> e;                          // ε_m at t_n per Gauss point
     std::array<std::array<Eigen::Matrix<double, 3, 9>, 3>, 9> tH;  // t_n H_m,c per Gauss point and c
-    double U = 0.0;  // strain energy U(u_n), bitwise internal()'s (the same expressions)
   };
   void step_state(const Vec45& u_n, const Charts& charts, StepState* st) const;
+  // The strain energy U(u_n) of a step state, with internal()'s expressions (so bitwise internal()'s energy at u_n)
+  // but without its frame and local variables: ½ wᵀ(K_bs w) + Σ_gp ½ dA εᵀ h D1 ε.
+  double step_energy(const StepState& st) const;
   double algorithmic_internal(const StepState& sn, const Vec45& u_n, const Vec45& u_np1, const Charts& charts,
                               double alpha_f, double xi, Vec45* F, Mat45* K) const;
 

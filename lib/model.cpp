@@ -437,7 +437,9 @@ void Model::step_energies(const Eigen::VectorXd& u_n, const std::vector<Director
   std::lock_guard<std::mutex> lock(cache.mutex);
   const std::vector<CR9Shell::StepState>& states = step_states(u_n, charts);
   U.resize(states.size());
-  for (size_t e = 0; e < states.size(); ++e) U[e] = states[e].U;
+  for_each_element(assembler_, [&](int e) {
+    U[static_cast<size_t>(e)] = elements_[static_cast<size_t>(e)].step_energy(states[static_cast<size_t>(e)]);
+  });
 }
 
 CR9Shell::Mat45 Model::reference_local_stiffness(int e) const {
