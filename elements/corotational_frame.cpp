@@ -51,7 +51,15 @@ CorotationalFrame::CorotationalFrame(const std::array<Eigen::Vector3d, 9>& x,
                                      const std::array<Eigen::Matrix<double, 3, 2>, 9>& A1,
                                      const std::array<Eigen::Matrix2d, 9>& d2pl,
                                      const std::array<DirectorChart, 9>& charts)
-    : p_(p), A1_(A1), d2pl_(d2pl) {
+    : CorotationalFrame(x, p, charts) {
+  A1_ = A1;
+  d2pl_ = d2pl;
+  director_derivatives_ = true;
+}
+
+CorotationalFrame::CorotationalFrame(const std::array<Eigen::Vector3d, 9>& x, const std::array<Eigen::Vector3d, 9>& p,
+                                     const std::array<DirectorChart, 9>& charts)
+    : p_(p), director_derivatives_(false) {
   for (int i = 0; i < 9; ++i) l_[i] = charts[i].l;
   // §3.1 triad from the unit diagonals.
   a_ = x[2] - x[0];
@@ -73,6 +81,8 @@ CorotationalFrame::CorotationalFrame(const std::array<Eigen::Vector3d, 9>& x,
 }
 
 void CorotationalFrame::compute_derivatives() const {
+  if (!director_derivatives_)
+    throw std::logic_error("CorotationalFrame: derivatives of a frame built for local_variables() only (no A1, d2pl)");
   const Eigen::Vector3d ex = R_.col(0), ey = R_.col(1);
   // §3.3 frame derivatives, per corner: G_a = [-I 0 I 0], G_b = [0 -I 0 I].
   Pa_ = unit_jacobian(a_);

@@ -30,6 +30,11 @@ class CorotationalFrame {
   CorotationalFrame(const std::array<Eigen::Vector3d, 9>& x, const std::array<Eigen::Vector3d, 9>& p,
                     const std::array<Eigen::Matrix<double, 3, 2>, 9>& A1,
                     const std::array<Eigen::Matrix2d, 9>& d2pl, const std::array<DirectorChart, 9>& charts);
+  // A frame for the triad, the origin and local_variables() only (the end point of a strain-averaged step): the
+  // director derivatives are not needed then, and any call that needs the frame's derivatives throws
+  // std::logic_error.
+  CorotationalFrame(const std::array<Eigen::Vector3d, 9>& x, const std::array<Eigen::Vector3d, 9>& p,
+                    const std::array<DirectorChart, 9>& charts);
 
   const Eigen::Matrix3d& R() const { return R_; }
   const Eigen::Vector3d& origin() const { return xO_; }
@@ -82,6 +87,7 @@ class CorotationalFrame {
   Eigen::Vector3d xO_, a_, b_, s_, c_;
   Eigen::Matrix3d R_;
   // Derivative data (compute_derivatives(); mutable: filled lazily by const methods, one frame per thread).
+  bool director_derivatives_ = true;  // false: built without A1, d2pl (local_variables() only)
   mutable bool have_derivatives_ = false, have_corner_columns_ = false;
   mutable Eigen::Matrix3d Pa_, Pb_, Ps_, Pc_;
   mutable std::array<std::array<Eigen::Matrix3d, 4>, 3> E_;

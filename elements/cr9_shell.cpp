@@ -244,7 +244,7 @@ CR9Shell::Vec45 CR9Shell::kbs_times(const Vec45& w) const {
   return y;
 }
 
-CorotationalFrame CR9Shell::local_increments(const Vec45& u, const Charts& charts, Vec45* w) const {
+CorotationalFrame CR9Shell::local_increments(const Vec45& u, const Charts& charts, Vec45* w, bool derivatives) const {
   std::array<Eigen::Vector3d, 9> x, p;
   std::array<Eigen::Matrix<double, 3, 2>, 9> A1;
   std::array<Eigen::Matrix2d, 9> d2;
@@ -252,10 +252,12 @@ CorotationalFrame CR9Shell::local_increments(const Vec45& u, const Charts& chart
     const Eigen::Vector2d q = u.segment<2>(5 * i + 3);
     x[i] = X0_[i] + u.segment<3>(5 * i);
     p[i] = director(q, charts[i]);
-    A1[i] = director_A1(q, charts[i]);
-    d2[i] = director_d2pl(q, charts[i]);
+    if (derivatives) {
+      A1[i] = director_A1(q, charts[i]);
+      d2[i] = director_d2pl(q, charts[i]);
+    }
   }
-  CorotationalFrame fr(x, p, A1, d2, charts);
+  const CorotationalFrame fr = derivatives ? CorotationalFrame(x, p, A1, d2, charts) : CorotationalFrame(x, p, charts);
   if (w) {
     std::array<Eigen::Vector3d, 9> d;
     for (int i = 0; i < 9; ++i) d[i] = u.segment<3>(5 * i);
@@ -407,8 +409,8 @@ double CR9Shell::algorithmic_internal(const Vec45& u_n, const Vec45& u_np1, cons
   // §6.3 steps 1-5: local states from each end configuration (same charts), strain averaging,
   // strain gradient at w̄ = (1-α_f) w_1 + α_f w_n, T and K_σ at u_mid.
   Vec45 wn, w1;
-  local_increments(u_n, charts, &wn);
-  local_increments(u_np1, charts, &w1);
+  local_increments(u_n, charts, &wn, false);
+  local_increments(u_np1, charts, &w1, false);
   const Vec45 u_mid = (1.0 - alpha_f) * u_np1 + alpha_f * u_n;
   const CorotationalFrame fr = local_increments(u_mid, charts, nullptr);
   const double c1 = 1.0 - alpha_f + xi, c0 = alpha_f - xi;
@@ -427,7 +429,7 @@ double CR9Shell::algorithmic_internal(const Vec45& u_n, const Vec45& u_np1, cons
 }
 
 void CR9Shell::step_state(const Vec45& u_n, const Charts& charts, StepState* st) const {
-  local_increments(u_n, charts, &st->w);
+  local_increments(u_n, charts, &st->w, false);
   st->Kw = kbs_times(st->w);
   const Mat39 t0 = translations(st->w);
   const Eigen::Map<const Eigen::Matrix<double, 27, 1>> v0(t0.data());
@@ -459,7 +461,7 @@ double CR9Shell::algorithmic_internal(const StepState& sn, const Vec45& u_n, con
   // As the plain overload, with w_n, ε_m(t_n) and t_n H_m from the step state.
   const Vec45& wn = sn.w;
   Vec45 w1;
-  local_increments(u_np1, charts, &w1);  // the frame at u_np1 serves w1 only (its derivatives are never formed)
+  local_increments(u_np1, charts, &w1, false);  // the frame at u_np1 serves w1 only (its derivatives are never formed)
   const Vec45 u_mid = (1.0 - alpha_f) * u_np1 + alpha_f * u_n;
   const CorotationalFrame fr = local_increments(u_mid, charts, nullptr);
   const double c1 = 1.0 - alpha_f + xi, c0 = alpha_f - xi;
@@ -533,7 +535,7 @@ void CR9Shell::inertial(const Vec45& u, const Vec45& v, const Charts& charts, Ve
 
 CR9Shell::Resultants CR9Shell::resultants(const Vec45& u, const Charts& charts) const {
   Vec45 w;
-  local_increments(u, charts, &w);
+  local_increments(u, charts, &w, false);
   const Mat39 t = translations(w);
   const Eigen::Map<const Eigen::Matrix<double, 27, 1>> v(t.data());
   const double h = mat_.thickness, G = mat_.E / (2.0 * (1.0 + mat_.nu));

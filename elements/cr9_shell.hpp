@@ -129,8 +129,9 @@ class CR9Shell {
   // instead of 27 small 3×9·9×9 products). Equal to membrane() to round-off.
   double membrane_force(const Mat39& t1, const Mat39& t0, double c1, double c0, double b1, double b0,
                         const StepState& n0, Vec45* fL) const;
-  // Local increments w = [t_i, Δθ_i] of u and the frame at u.
-  CorotationalFrame local_increments(const Vec45& u, const Charts& charts, Vec45* w) const;
+  // Local increments w = [t_i, Δθ_i] of u and the frame at u. derivatives = false: a frame for w only (the
+  // directors' A1 and d2pl are not evaluated; the frame's derivatives cannot be formed).
+  CorotationalFrame local_increments(const Vec45& u, const Charts& charts, Vec45* w, bool derivatives = true) const;
 
   std::array<Eigen::Vector3d, 9> X0_;
   std::array<Eigen::Vector3d, 9> xl0_;  // initial local coordinates x_i0 (§3.2)
