@@ -12,6 +12,11 @@
 // translation unit of an executable adds a start-up function that, when OMP_WAIT_POLICY is not set,
 // sets it to passive and re-executes the program (same PID, arguments and environment otherwise). An
 // OMP_WAIT_POLICY set by the user (e.g. active on a dedicated machine) is respected.
+//
+// The same re-execution sets OPENBLAS_NUM_THREADS=1 when it is not set. shelldyn runs BLAS on one thread anyway
+// (lib/linear_solver.cpp limit_blas_threads()), but OpenBLAS's pthread build starts its thread pool when it is
+// loaded, and the pool's thread spins (sched_yield) for a while after start-up: ~2 % of a 5 s run's CPU on the
+// flying plate. With the variable set, no pool is created.
 #pragma once
 
 #if defined(__linux__) && defined(__GNUC__)
@@ -23,6 +28,7 @@ namespace shelldyn::detail {
 __attribute__((constructor)) inline void openmp_wait_passive(int, char** argv, char**) {
   if (std::getenv("OMP_WAIT_POLICY") != nullptr || argv == nullptr || argv[0] == nullptr) return;
   if (setenv("OMP_WAIT_POLICY", "passive", 0) != 0) return;
+  setenv("OPENBLAS_NUM_THREADS", "1", 0);  // keeps a value the user set
   execv("/proc/self/exe", argv);  // returns only on failure: then run on with libgomp's default policy
 }
 }  // namespace shelldyn::detail
