@@ -5,6 +5,7 @@
 #include <string>
 
 #include "element_fixtures.hpp"
+#include "elements/corotational_frame.hpp"
 
 namespace shelldyn::testing {
 namespace {
@@ -17,6 +18,27 @@ std::string message_of(F&& f) {
     return e.what();
   }
   return "<no exception>";
+}
+
+// A frame built without the directors' derivatives (end points of a strain-averaged step) gives the same local
+// variables as a full frame, and refuses what needs its derivatives instead of using unset data.
+TEST(CR9Errors, FrameWithoutDirectorDerivativesRefusesDerivatives) {
+  const Geometry g = make_geometry(Shape::Distorted, Facing::Y);
+  std::array<DirectorChart, 9> ch;
+  std::array<Eigen::Matrix<double, 3, 2>, 9> A1;
+  std::array<Eigen::Matrix2d, 9> d2;
+  for (int i = 0; i < 9; ++i) {
+    ch[static_cast<size_t>(i)] = select_chart(g.p0[static_cast<size_t>(i)]);
+    const Eigen::Vector2d q = chart_coordinates(g.p0[static_cast<size_t>(i)], ch[static_cast<size_t>(i)]);
+    A1[static_cast<size_t>(i)] = director_A1(q, ch[static_cast<size_t>(i)]);
+    d2[static_cast<size_t>(i)] = director_d2pl(q, ch[static_cast<size_t>(i)]);
+  }
+  const CorotationalFrame full(g.X0, g.p0, A1, d2, ch), light(g.X0, g.p0, ch);
+  EXPECT_EQ((full.local_variables(g.X0) - light.local_variables(g.X0)).cwiseAbs().maxCoeff(), 0.0);
+  EXPECT_NO_THROW(full.matrix());
+  const std::string msg = message_of<std::logic_error>([&] { light.matrix(); });
+  EXPECT_NE(msg.find("local_variables() only"), std::string::npos) << msg;
+  EXPECT_THROW(light.apply_transpose(CorotationalFrame::Vec45::Ones()), std::logic_error);
 }
 
 TEST(CR9Errors, OrientationCheckNamesTheNode) {
