@@ -421,16 +421,6 @@ void Model::scalar_mass_times(const Eigen::VectorXd& x, Eigen::VectorXd& y) cons
   });
 }
 
-void Model::element_energies(const Eigen::VectorXd& u, const std::vector<DirectorChart>& charts,
-                             std::vector<double>& U) const {
-  U.assign(elements_.size(), 0.0);
-  for_each_element(assembler_, [&](int e) {
-    CR9Shell::Vec45 ue;
-    gather(e, u, ue);
-    U[static_cast<size_t>(e)] = elements_[static_cast<size_t>(e)].internal(ue, element_charts(e, charts), nullptr, nullptr);
-  });
-}
-
 void Model::step_energies(const Eigen::VectorXd& u_n, const std::vector<DirectorChart>& charts,
                           std::vector<double>& U) const {
   StepCache& cache = *step_cache_;

@@ -114,10 +114,9 @@ class Model final : public SemiDiscreteSystem {
   // ---- Embedded kinematics of the exactly conserving step em-exact (docs/theory/exact-energy-momentum.md) ----
   // y = (m ⊗ I₃) x: x, y hold one 3-vector per node; m = Σ_e ∫ N_i N_j dA (consistent scalar mass).
   void scalar_mass_times(const Eigen::VectorXd& x, Eigen::VectorXd& y) const;
-  // Strain energy U_e(u) of every element (U.size() = number of elements).
-  void element_energies(const Eigen::VectorXd& u, const std::vector<DirectorChart>& charts, std::vector<double>& U) const;
-  // The same at the start u_n of a step, from the step's element states (CR9Shell::step_energy(), bitwise
-  // element_energies()'s values): no frames or local variables of its own when the step's states are needed anyway.
+  // Strain energy U_e(u_n) of every element at the start u_n of a step (U.size() = number of elements), from the
+  // step's element states (CR9Shell::step_energy(): bitwise CR9Shell::internal()'s energy), so no frames or local
+  // variables of its own when the step's states are needed anyway.
   void step_energies(const Eigen::VectorXd& u_n, const std::vector<DirectorChart>& charts, std::vector<double>& U) const;
   // Linear local stiffness k_L at the stress-free reference state of element e (symmetric PSD, zero on rigid modes).
   CR9Shell::Mat45 reference_local_stiffness(int e) const;
