@@ -17,6 +17,10 @@ namespace {
 
 using Row27 = Eigen::Matrix<double, 1, 27>;
 using Row45 = Eigen::Matrix<double, 1, 45>;
+
+// Membrane energy of one Gauss point, ½ dA εᵀ h D1 ε (§4.6). One expression for membrane(), membrane_force() and
+// step_energy(), so that their energies agree bit for bit (em-exact's ΔU relies on it).
+double membrane_energy(double dA, const Eigen::Vector3d& e, const Eigen::Matrix3d& hD1) { return 0.5 * dA * e.dot(hD1 * e); }
 using Mat9 = Eigen::Matrix<double, 9, 9>;
 
 // Covariant strain functionals at one point (§4.3). Index ab: 0 = ξξ, 1 = ηη, 2 = ξη.
@@ -306,7 +310,7 @@ double CR9Shell::membrane(const Mat39& t1, const Mat39& t0, double c1, double c0
       }
     }
     const Eigen::Vector3d N = hD1 * (c1 * e1 + c0 * e0);  // N* = h D1 ε*_m (§6.3)
-    U += 0.5 * gp.dA * e1.dot(hD1 * e1);
+    U += membrane_energy(gp.dA, e1, hD1);
     fm.noalias() += gp.dA * Bm.transpose() * N;
     if (kL) {
       const Eigen::Matrix<double, 3, 27> DB = (gp.dA * hD1) * Bm;
@@ -345,7 +349,7 @@ double CR9Shell::membrane_force(const Mat39& t1, const Mat39& t0, double c1, dou
     const Eigen::Vector3d eg = e1.segment<3>(3 * g);
     const Eigen::Vector3d N = hD1 * (c1 * eg + c0 * n0.e[static_cast<size_t>(g)]);
     const double dA = dAall_(3 * g);
-    U += 0.5 * dA * eg.dot(hD1 * eg);
+    U += membrane_energy(dA, eg, hD1);
     sN.segment<3>(3 * g) = dA * N;
   }
   // Σ_gp dA B_mᵀ N with B_m,c = L_m,c + (t̄ H_c) rows, t̄ = b1 t1 + b0 t0: Lᵀ s + t̄ Σ_gp,c s_gp,c H_c.
@@ -446,7 +450,7 @@ double CR9Shell::step_energy(const StepState& st) const {
   const Vec45 f = Kbs_ * st.w;
   const Eigen::Matrix3d hD1 = mat_.thickness * D1_;
   double Um = 0.0;
-  for (size_t g = 0; g < gp_.size(); ++g) Um += 0.5 * gp_[g].dA * st.e[g].dot(hD1 * st.e[g]);
+  for (size_t g = 0; g < gp_.size(); ++g) Um += membrane_energy(gp_[g].dA, st.e[g], hD1);
   return 0.5 * st.w.dot(f) + Um;
 }
 
