@@ -119,6 +119,15 @@ inline Eigen::Matrix3d random_rotation(std::mt19937& rng, double angle) {
   return Eigen::AngleAxisd(angle, axis).toRotationMatrix();
 }
 
+// 45 values amp·U(−1, 1), drawn in order from std::mt19937(seed) (a random increment or direction of the DOFs).
+inline Vec45 random_vector(double amp, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> U(-1.0, 1.0);
+  Vec45 v;
+  for (int j = 0; j < 45; ++j) v(j) = amp * U(rng);
+  return v;
+}
+
 // Random deformed state: nodal translations of size amp*L, directors turned by up to amp rad, then
 // a rigid rotation by `rigid_angle` (large rotations), charts re-selected from the current directors.
 inline Vec45 random_state(const Geometry& g, double amp, double rigid_angle, unsigned seed, Charts* ch,

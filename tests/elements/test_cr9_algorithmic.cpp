@@ -33,10 +33,7 @@ TEST(CR9Algorithmic, StepStateOverloadIsBitwiseTheSame) {
     const CR9Shell e(g.X0, g.p0, test_material());
     Charts ch;
     const Vec45 un = random_state(g, 0.05, 0.6, 21, &ch);
-    std::mt19937 rng(23);
-    std::uniform_real_distribution<double> U(-1.0, 1.0);
-    Vec45 u1 = un;
-    for (int j = 0; j < 45; ++j) u1(j) += 0.01 * U(rng);
+    const Vec45 u1 = un + random_vector(0.01, 23);
     CR9Shell::StepState sn, other;
     e.step_state(un, ch, &sn);
     e.step_state(u1, ch, &other);
@@ -63,10 +60,7 @@ TEST(CR9Algorithmic, StepStateEnergyIsInternalsEnergy) {
     const CR9Shell e(g.X0, g.p0, test_material());
     Charts ch;
     const Vec45 un = random_state(g, 0.05, 0.6, 31, &ch);
-    std::mt19937 rng(37);
-    std::uniform_real_distribution<double> U(-1.0, 1.0);
-    Vec45 u1 = un;
-    for (int j = 0; j < 45; ++j) u1(j) += 0.01 * U(rng);
+    const Vec45 u1 = un + random_vector(0.01, 37);
     CR9Shell::StepState sn, s1;
     e.step_state(un, ch, &sn);
     e.step_state(u1, ch, &s1);
@@ -86,10 +80,7 @@ TEST(CR9Algorithmic, EnergyBalanceErrorIsThirdOrder) {
       const CR9Shell e(g.X0, g.p0, test_material());
       Charts ch;
       const Vec45 un = random_state(g, 0.05, 0.7, 13, &ch);
-      std::mt19937 rng(19);
-      std::uniform_real_distribution<double> U(-1.0, 1.0);
-      Vec45 dir;
-      for (int j = 0; j < 45; ++j) dir(j) = 0.004 * U(rng);
+      const Vec45 dir = random_vector(0.004, 19);
       const double Un = e.internal(un, ch, nullptr, nullptr);
       double prev = 0.0;
       for (int level = 0; level < 4; ++level) {
@@ -122,10 +113,7 @@ TEST(CR9Algorithmic, PositiveXiDissipates) {
   const CR9Shell e(g.X0, g.p0, test_material());
   Charts ch;
   const Vec45 un = random_state(g, 0.05, 0.7, 13, &ch);
-  std::mt19937 rng(23);
-  std::uniform_real_distribution<double> U(-1.0, 1.0);
-  Vec45 du;
-  for (int j = 0; j < 45; ++j) du(j) = 0.01 * U(rng);
+  const Vec45 du = random_vector(0.01, 23);
   const Vec45 u1 = un + du;
   Vec45 F0, F1;
   const double Un = e.internal(un, ch, nullptr, nullptr);

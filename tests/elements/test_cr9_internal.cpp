@@ -109,10 +109,7 @@ TEST_P(CR9Internal, SmallStrainForceIndependentOfFarTranslation) {
 TEST_P(CR9Internal, TangentsAreSymmetric) {
   Charts ch;
   const Vec45 u1 = random_state(g, 0.08, 0.5, 21, &ch);
-  Vec45 u0 = u1;
-  std::mt19937 rng(4);
-  std::uniform_real_distribution<double> U(-1.0, 1.0);
-  for (int j = 0; j < 45; ++j) u0(j) += 0.01 * U(rng);
+  const Vec45 u0 = u1 + random_vector(0.01, 4);
   Mat45 K, Ka;
   elem.internal(u1, ch, nullptr, &K);
   elem.algorithmic_internal(u0, u1, ch, 0.45, 0.05, nullptr, &Ka);
