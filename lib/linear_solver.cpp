@@ -4,6 +4,7 @@
 #include "lib/linear_solver.hpp"
 
 #include "lib/profile.hpp"
+#include "lib/single_precision_factor.hpp"
 
 #include <Eigen/SparseCholesky>
 #include <cholmod.h>
@@ -147,6 +148,7 @@ class CholmodSolver final : public LinearSolver {
     check_same_shape(A, n_, nnz_, "cholmod");
     check_values(A, "cholmod");
     factorized_ = false;
+    sp_.clear();
     const auto t0 = Clock::now();
     cholmod_sparse S = header(A);
     single_threaded([&] { cholmod_l_factorize(&S, L_, &cc_); });
@@ -178,6 +180,14 @@ class CholmodSolver final : public LinearSolver {
     }
     factorized_ = true;
     ++stats_.factorizations;
+    if (single_) copy_to_single();
+  }
+
+  bool set_single_precision_solves(bool on) override {
+    single_ = on;
+    if (!on) sp_.clear();
+    else if (factorized_) copy_to_single();
+    return true;
   }
 
   // LLᵀ succeeded: positive definite. Simplicial LDLᵀ: D is the diagonal of L (CHOLMOD's LDL' layout).
@@ -195,6 +205,13 @@ class CholmodSolver final : public LinearSolver {
     profile::Scope prof(profile::Section::solve);
     if (!factorized_) throw std::logic_error("cholmod: solve() called without a valid factorization");
     const auto t0 = Clock::now();
+    if (!sp_.empty()) {  // single-precision copy of the supernodal factor (lib/single_precision_factor.hpp)
+      sp_.solve(b, x);
+      ++stats_.solves;
+      ++stats_.single_solves;
+      stats_.solve_s += seconds_since(t0);
+      return;
+    }
     cholmod_dense B{};
     B.nrow = static_cast<size_t>(n_);
     B.ncol = 1;
@@ -238,6 +255,22 @@ class CholmodSolver final : public LinearSolver {
   void release() {
     if (L_) cholmod_l_free_factor(&L_, &cc_);
     factorized_ = false;
+    sp_.clear();
+  }
+  // Only a supernodal LLᵀ factor is copied; a simplicial LDLᵀ one (the indefinite fallback) keeps double solves.
+  void copy_to_single() {
+    sp_.clear();
+    if (!factorized_ || !L_->is_super || !L_->is_ll) return;
+    SinglePrecisionFactor::Arrays a;
+    a.n = static_cast<Index>(L_->n);
+    a.nsuper = static_cast<Index>(L_->nsuper);
+    a.super = static_cast<const Index*>(L_->super);
+    a.pi = static_cast<const Index*>(L_->pi);
+    a.px = static_cast<const Index*>(L_->px);
+    a.s = static_cast<const Index*>(L_->s);
+    a.x = static_cast<const double*>(L_->x);
+    a.perm = static_cast<const Index*>(L_->Perm);
+    sp_.assign(a);
   }
 
   mutable cholmod_common cc_{};
@@ -246,6 +279,8 @@ class CholmodSolver final : public LinearSolver {
   Index n_ = 0, nnz_ = 0;
   bool ldlt_ = false;
   bool factorized_ = false;
+  bool single_ = false;
+  SinglePrecisionFactor sp_;  // non-empty: solves use it
 };
 
 // ------------------------------------------------------------------------------------------------
@@ -663,6 +698,16 @@ void check_csc_pattern(const CscView& A, const std::string& who) {
       }
     }
   }
+}
+
+bool single_precision_setting(const std::string& value, const std::string& linear_solver, const std::string& who) {
+  if (value != "double" && value != "single")
+    throw std::invalid_argument(who + ".solve_precision: '" + value + "' (use double or single)");
+  if (value == "double") return false;
+  if (!make_linear_solver(linear_solver)->set_single_precision_solves(true))
+    throw std::invalid_argument(who + ".solve_precision: single needs linear_solver=cholmod (got '" + linear_solver +
+                                "', whose solves are double only; docs/dependencies.md §5.5)");
+  return true;
 }
 
 std::vector<std::string> linear_solver_names() { return {"cholmod", "eigen-ldlt", "klu", "mumps"}; }

@@ -9,6 +9,7 @@
 // "klu" factors the full storage and also works for non-symmetric matrices (e.g. ida-bdf's Schur complement
 // with jacobian=fd-inertia, or unsymmetric load tangents in statics).
 //   - "cholmod":    CHOLMOD (cholmod_l_*), upper triangle (stype = +1), AMD ordering, supernodal LLᵀ.
+//                   Optionally solves with a float copy of the factor (set_single_precision_solves below).
 //                   If the matrix is not positive definite (CHOLMOD_NOT_POSDEF), the solver switches
 //                   PERMANENTLY to simplicial LDLᵀ (re-analysis once; visible as an extra count in
 //                   stats().analyses) and retries. Rationale: a tangent that was indefinite once
@@ -77,9 +78,18 @@ class LinearSolver {
   // cannot tell (KLU's LU pivots are not an inertia). Requires factorized().
   virtual long negative_pivots() const { return -1; }
 
+  // Mixed precision (docs/dependencies.md §5.5): on = do the triangular solves with a single-precision copy of
+  // the factor (made at each factorize()), which halves the memory traffic of a solve; the factorization and
+  // all arithmetic stay double, but a solve is then accurate to ~1e-7·cond(A) only: meant for modified Newton,
+  // whose kept matrix is an approximation anyway. Returns false (and keeps double solves) where the back-end
+  // cannot: only "cholmod" can, and only while its factor is supernodal LLᵀ (after a fallback to simplicial
+  // LDLᵀ its solves are double again; stats().single_solves counts the solves really done in single).
+  virtual bool set_single_precision_solves(bool on) { return !on; }
+
   // Counters and process-independent wall times (std::chrono::steady_clock) in seconds.
   struct Stats {
     long analyses = 0, factorizations = 0, solves = 0;
+    long single_solves = 0;  // of solves, those done with a single-precision factor
     double analyze_s = 0, factorize_s = 0, solve_s = 0;
   };
   const Stats& stats() const { return stats_; }
@@ -93,6 +103,11 @@ std::unique_ptr<LinearSolver> make_linear_solver(const std::string& name);
 std::vector<std::string> linear_solver_names();
 // True if make_linear_solver(name) knows the name (lets callers validate settings before building a solver).
 bool is_linear_solver_name(const std::string& name);
+
+// An integrator's `solve_precision` setting: "double" -> false, "single" -> true (LinearSolver::
+// set_single_precision_solves). Throws std::invalid_argument naming `who` for any other value, and for "single"
+// with a back-end that cannot do it (only "cholmod" can).
+bool single_precision_setting(const std::string& value, const std::string& linear_solver, const std::string& who);
 
 // Structural checks shared by the back-ends (and useful to callers): n > 0, colptr[0] == 0,
 // non-decreasing colptr, row indices in [0, n) and strictly increasing within each column.

@@ -14,10 +14,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <memory>
 #include <random>
 #include <stdexcept>
 #include <string>
+#include <tuple>
 #include <vector>
 
 namespace shelldyn {
@@ -252,6 +254,93 @@ TEST(LinearSolver, SpdMatrixKeepsCholmodSupernodal) {
   auto s = make_linear_solver("cholmod");
   s->factorize(A.view());
   EXPECT_EQ(s->stats().analyses, 1);  // no fallback re-analysis
+}
+
+// Single-precision solves (docs/dependencies.md §5.5): CHOLMOD's supernodal factor copied to float. A solve is then
+// exact for a matrix within ~6e-8 (float rounding) of A, so its residual lies far above a double solve's (~1e-16)
+// and below 1e-5 on this well-conditioned matrix; the refinement x += solve(b − A x) that modified Newton does
+// contracts the residual by about that factor per pass and reaches double precision. On the 16 x 16 pattern
+// (5445 unknowns) the factor has supernodes of every size, so all code paths of the kernel run.
+TEST(LinearSolver, CholmodSinglePrecisionSolvesRefineToDouble) {
+  const SparseMatrix A = shell_like_matrix(16, 30);
+  const auto b = random_vector(A.pattern->n, 31);
+  auto s = make_linear_solver("cholmod");
+  ASSERT_TRUE(s->set_single_precision_solves(true));
+  s->factorize(A.view());
+  std::vector<double> x(b.size());
+  s->solve(b.data(), x.data());
+  const double res1 = relative_residual(A.view(), x, b);
+  EXPECT_EQ(s->stats().single_solves, 1);
+  EXPECT_LT(res1, 1e-5);
+  EXPECT_GT(res1, 1e-11);  // really the float factor: a double solve gives ~1e-16
+  // In place: the same numbers bit for bit.
+  std::vector<double> y = b;
+  s->solve(y.data(), y.data());
+  EXPECT_EQ(y, x);
+  // Refinement with the double residual.
+  std::vector<double> r(b.size()), d(b.size());
+  double res = res1;
+  int passes = 0;
+  while (res > 1e-14 && passes < 6) {
+    for (Index j = 0; j < A.pattern->n; ++j) r[j] = b[j];
+    for (Index j = 0; j < A.pattern->n; ++j)
+      for (Index p = A.pattern->colptr[j]; p < A.pattern->colptr[j + 1]; ++p) r[A.pattern->rowind[p]] -= A.values[p] * x[j];
+    s->solve(r.data(), d.data());
+    for (size_t i = 0; i < x.size(); ++i) x[i] += d[i];
+    res = relative_residual(A.view(), x, b);
+    ++passes;
+  }
+  std::printf("[ info ] single-precision solve: residual %.2e; after %d refinement passes %.2e\n", res1, passes, res);
+  EXPECT_LT(res, 1e-14);
+  EXPECT_LE(passes, 3);
+  // Switched off: double solves again.
+  ASSERT_TRUE(s->set_single_precision_solves(false));
+  const long singles = s->stats().single_solves;
+  s->solve(b.data(), x.data());
+  EXPECT_LT(relative_residual(A.view(), x, b), 1e-12);
+  EXPECT_EQ(s->stats().single_solves, singles);
+}
+
+// The other back-ends decline (and keep double solves); an indefinite matrix makes CHOLMOD fall back to simplicial
+// LDLᵀ, whose solves stay double; the integrators' setting names the back-end it needs.
+TEST(LinearSolver, SinglePrecisionSolvesOnlyWithCholmodSupernodal) {
+  const SparseMatrix A = shell_like_matrix(3, 32);
+  const auto b = random_vector(A.pattern->n, 33);
+  for (const auto& name : linear_solver_names()) {
+    auto s = make_linear_solver(name);
+    EXPECT_TRUE(s->set_single_precision_solves(false)) << name;
+    if (name == "cholmod") continue;
+    EXPECT_FALSE(s->set_single_precision_solves(true)) << name;
+    s->factorize(A.view());
+    std::vector<double> x(b.size());
+    s->solve(b.data(), x.data());
+    EXPECT_LT(relative_residual(A.view(), x, b), 1e-12) << name;
+    EXPECT_EQ(s->stats().single_solves, 0) << name;
+  }
+  const SparseMatrix B = shell_like_matrix(2, 14, -0.5);  // indefinite (test above)
+  auto s = make_linear_solver("cholmod");
+  ASSERT_TRUE(s->set_single_precision_solves(true));
+  s->factorize(B.view());
+  std::vector<double> x(B.pattern->n);
+  const auto c = random_vector(B.pattern->n, 15);
+  s->solve(c.data(), x.data());
+  EXPECT_LT(relative_residual(B.view(), x, c), 1e-9);
+  EXPECT_EQ(s->stats().single_solves, 0);
+  EXPECT_EQ(s->stats().analyses, 2);  // the LDLᵀ fallback re-analysed
+  EXPECT_FALSE(single_precision_setting("double", "klu", "em-galpha"));
+  EXPECT_TRUE(single_precision_setting("single", "cholmod", "em-galpha"));
+  for (const auto& [value, solver, expect] :
+       std::vector<std::tuple<std::string, std::string, std::string>>{{"half", "cholmod", "'half' (use double or single)"},
+                                                                       {"single", "klu", "needs linear_solver=cholmod"}}) {
+    try {
+      single_precision_setting(value, solver, "em-galpha");
+      ADD_FAILURE() << value << " with " << solver << " accepted";
+    } catch (const std::invalid_argument& e) {
+      const std::string msg = e.what();
+      EXPECT_EQ(msg.rfind("em-galpha.solve_precision: ", 0), 0u) << msg;
+      EXPECT_NE(msg.find(expect), std::string::npos) << msg;
+    }
+  }
 }
 
 // No hidden threads: CHOLMOD's supernodal kernels open OpenMP regions with a fixed num_threads(4) and
