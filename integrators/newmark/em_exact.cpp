@@ -47,6 +47,8 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
       throw std::invalid_argument("em-exact.predictor: '" + predictor + "' (use none or trapezoidal)");
     predictor_ = (predictor == "trapezoidal");
     make_linear_solver(nopt_.linear_solver);
+    nopt_.single_precision_solves =  // float copy of the kept factor (docs/dependencies.md §5.5)
+        single_precision_setting(s.get("solve_precision", "double"), nopt_.linear_solver, "em-exact");
     // KINSOL never stops on its own (tolerances at the bottom of the double range): the iteration hook
     // applies the residual / stagnation rule of theory §5.
     nopt_.stop = StopTest::fnorm;

@@ -13,8 +13,9 @@
 // Settings: rho_inf [1] and xi [0] (dissipation; ξ_eff = ξ + (1−ρ∞)/(2(1+ρ∞)), theory §6),
 //   newton full|modified [full], refresh [0.03 with modified Newton, else 0: refresh K̄ when the observed
 //   contraction exceeds it], setup_every [20; 1e6 when refresh > 0], predictor none|trapezoidal [trapezoidal
-//   with modified Newton, else none], linear_solver [cholmod], res_tol [1e-12], stall_tol [1e-6],
-//   stall_ratio [0.5], stall_step [1e-6], max_iters [25], max_cuts [0], hysteresis [1],
+//   with modified Newton, else none], linear_solver [cholmod], solve_precision [double] (or single: float copy
+//   of the factor, docs/dependencies.md §5.5), res_tol [1e-12], stall_tol [1e-6], stall_ratio [0.5],
+//   stall_step [1e-6], max_iters [25], max_cuts [0], hysteresis [1],
 //   correction [true] (false = the paper's force without the §3 correction: for tests that must fail).
 // Checkpoints (docs/architecture.md "Checkpoints and resume"): save/restore continue bitwise, with modified
 // Newton too; a stop request (SIGINT, --max-wall) is honoured at the next step boundary.

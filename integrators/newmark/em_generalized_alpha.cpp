@@ -96,6 +96,9 @@ class NewmarkFamily final : public Integrator {
     // (benchmarks/bench_step_breakdown.cpp).
     nopt_.linear_solver = s.get("linear_solver", "cholmod");
     make_linear_solver(nopt_.linear_solver);  // validate the name now, not at the first step
+    // Triangular solves with a float copy of the kept factor (docs/dependencies.md §5.5): half the memory traffic
+    // of a solve; the iteration still converges to the double-precision residual's tolerance.
+    nopt_.single_precision_solves = single_precision_setting(s.get("solve_precision", "double"), nopt_.linear_solver, name_);
     // Paper eq. 39 (docs/theory.md §6.5): stop when cc = |Δu^(k+1)·P̄^(k)| / |Δu^(1)·P̄^(0)| ≤ cc_tol.
     // Default 1e-12, far tighter than the paper's 1e-6: conservation studies need the algebraic error well
     // below the time-discretization error (with 1e-8 a tumbling plate drifts by 3e-7 in 2000 steps, with

@@ -26,6 +26,8 @@
 //     the scaled step test |Δu_i| ≤ step_tol max(1, |u_n,i|)
 //     (round-off reached; step_refresh = true: KINSOL's test instead, which refreshes K̄ and iterates once
 //     more). A step that fails is retried with full Newton. linear_solver: cholmod|eigen-ldlt|klu|mumps [cholmod],
+//   solve_precision: double|single [double] (single: triangular solves with a float copy of CHOLMOD's factor,
+//     docs/dependencies.md §5.5; cholmod only),
 //   cc_tol [1e-12; 1e-14 with modified Newton] (paper eq. 39 energy ratio; the paper uses 1e-6), step_tol [1e-14],
 //   min_iters [1], max_iters [25],
 //   max_cuts [0] (step cutting: a failed step is retried as two half steps, recursively), hysteresis [1].

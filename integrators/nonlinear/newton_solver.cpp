@@ -177,7 +177,14 @@ NewtonSolver::NewtonSolver(std::shared_ptr<const SparsePattern> pattern, NewtonO
   // KINSOL's per-iteration norms and updates on vectorized loops (before KINInit clones its work vectors from u).
   for (N_Vector v : {s.u.get(), s.uscale.get(), s.fscale.get()}) use_vectorized_ops(v);
   s.J = make_csc_matrix(*pattern, s.ctx);
-  s.LS.reset(make_sun_linear_solver(s.ctx, make_linear_solver(s.opt.linear_solver)));
+  {
+    auto ls = make_linear_solver(s.opt.linear_solver);
+    if (s.opt.single_precision_solves && !ls->set_single_precision_solves(true))
+      throw std::invalid_argument("NewtonSolver: linear_solver '" + s.opt.linear_solver +
+                                  "' has no single-precision solves (docs/dependencies.md §5.5); use cholmod, "
+                                  "or double solves");
+    s.LS.reset(make_sun_linear_solver(s.ctx, std::move(ls)));
+  }
   s.Jwork.pattern = pattern;
   s.Jwork.values.assign(pattern->nnz(), 0.0);
   for (auto* v : {&s.cache_u, &s.cache_f, &s.f_start, &s.u_prev, &s.du}) v->assign(s.n, 0.0);

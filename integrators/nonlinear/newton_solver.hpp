@@ -73,6 +73,10 @@ struct NewtonOptions {
   double step_tol = 1e-14;   // KINSetScaledStepTol: ‖uscale·Δu‖∞
   bool line_search = false;  // KIN_LINESEARCH instead of KIN_NONE
   std::string linear_solver = "eigen-ldlt";  // make_linear_solver() name
+  // Triangular solves with a single-precision copy of the factor (LinearSolver::set_single_precision_solves,
+  // docs/dependencies.md §5.5): "cholmod" only (the constructor throws for the others). Meant for modified
+  // Newton: the converged iterate is still set by the double-precision residual.
+  bool single_precision_solves = false;
   double max_newton_step = 1e30;  // KINSetMaxNewtonStep; large: the default is 1 when u0 = 0
   StopTest stop = StopTest::fnorm;
   double energy_tol = 1e-6;    // cc threshold of the energy test (paper: 1e-6)
