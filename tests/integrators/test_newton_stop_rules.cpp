@@ -138,35 +138,40 @@ TEST(NewtonStopRules, ModifiedNewtonEndsAStalledIterationWithoutRefreshing) {
   EXPECT_LT((kinsol.u - step.u).norm(), 1e-9 * step.u.norm());
 }
 
+// The flying plate's first `steps` steps (apps/cases/flying-plate.yaml, loads acting) under em-galpha with modified
+// Newton and the given settings: the totals, the final u, and K + V − W_ext after every step.
+struct PlateRun {
+  StepReport rep;
+  Eigen::VectorXd u;
+  std::vector<double> balance;  // K + V − W_ext per step
+  double energy = 0.0;          // largest K + V
+};
+PlateRun run_flying_plate(std::vector<std::pair<std::string, std::string>> settings, double dt, int steps) {
+  Problem p = load_problem(std::string(SHELLDYN_SOURCE_DIR) + "/apps/cases/flying-plate.yaml");
+  State s = p.initial_state();
+  settings.push_back({"newton", "modified"});
+  IntegratorSettings is("em-galpha", settings);
+  auto integ = make_integrator(is, dt);
+  integ->initialize(*p.model, s);
+  PlateRun t;
+  for (int k = 1; k <= steps; ++k) {
+    t.rep.accumulate(integ->advance(*p.model, s, k * dt));
+    const Invariants inv = p.model->invariants(s);
+    t.balance.push_back(inv.kinetic + inv.strain - integ->external_work());
+    t.energy = std::max(t.energy, inv.kinetic + inv.strain);
+  }
+  t.u = s.u;
+  return t;
+}
+
 // floor_test = estimate, the modified-Newton default (docs/theory.md §6.5), against the plain floor test and
 // against iterating to round-off, on the flying plate's first 0.4 s (apps/cases/flying-plate.yaml, loads
 // acting): fewer iterations, the same solution and energy balance to far below the discretisation error.
 TEST(NewtonStopRules, EstimatedFloorTestSavesIterationsAtTheSameSolution) {
-  struct Totals {
-    StepReport rep;
-    Eigen::VectorXd u;
-    std::vector<double> balance;  // K + V − W_ext per step
-    double energy = 0.0;          // largest K + V
-  };
+  using Totals = PlateRun;
   const double dt = 1e-3;
   const int steps = 400;
-  auto run = [&](std::vector<std::pair<std::string, std::string>> settings) {
-    Problem p = load_problem(std::string(SHELLDYN_SOURCE_DIR) + "/apps/cases/flying-plate.yaml");
-    State s = p.initial_state();
-    settings.push_back({"newton", "modified"});
-    IntegratorSettings is("em-galpha", settings);
-    auto integ = make_integrator(is, dt);
-    integ->initialize(*p.model, s);
-    Totals t;
-    for (int k = 1; k <= steps; ++k) {
-      t.rep.accumulate(integ->advance(*p.model, s, k * dt));
-      const Invariants inv = p.model->invariants(s);
-      t.balance.push_back(inv.kinetic + inv.strain - integ->external_work());
-      t.energy = std::max(t.energy, inv.kinetic + inv.strain);
-    }
-    t.u = s.u;
-    return t;
-  };
+  auto run = [&](std::vector<std::pair<std::string, std::string>> settings) { return run_flying_plate(settings, dt, steps); };
   const Totals ref = run({{"e_floor", "1e-30"}, {"cc_tol", "1e-30"}});  // iterated to round-off
   const Totals corr = run({{"floor_test", "correction"}});
   const Totals est = run({});  // default: floor_test = estimate
@@ -198,29 +203,8 @@ TEST(NewtonStopRules, EstimatedFloorTestSavesIterationsAtTheSameSolution) {
 TEST(NewtonStopRules, SinglePrecisionSolvesReachTheSameSolution) {
   const double dt = 1e-3;
   const int steps = 400;
-  struct Totals {
-    StepReport rep;
-    Eigen::VectorXd u;
-    std::vector<double> balance;
-    double energy = 0.0;
-  };
-  auto run = [&](const std::string& precision) {
-    Problem p = load_problem(std::string(SHELLDYN_SOURCE_DIR) + "/apps/cases/flying-plate.yaml");
-    State s = p.initial_state();
-    IntegratorSettings is("em-galpha", {{"newton", "modified"}, {"solve_precision", precision}});
-    auto integ = make_integrator(is, dt);
-    integ->initialize(*p.model, s);
-    Totals t;
-    for (int k = 1; k <= steps; ++k) {
-      t.rep.accumulate(integ->advance(*p.model, s, k * dt));
-      const Invariants inv = p.model->invariants(s);
-      t.balance.push_back(inv.kinetic + inv.strain - integ->external_work());
-      t.energy = std::max(t.energy, inv.kinetic + inv.strain);
-    }
-    t.u = s.u;
-    return t;
-  };
-  const Totals dbl = run("double"), sgl = run("single");
+  const PlateRun dbl = run_flying_plate({{"solve_precision", "double"}}, dt, steps);
+  const PlateRun sgl = run_flying_plate({{"solve_precision", "single"}}, dt, steps);
   double gap = 0.0;
   for (size_t k = 0; k < dbl.balance.size(); ++k) gap = std::max(gap, std::abs(sgl.balance[k] - dbl.balance[k]));
   gap /= dbl.energy;
