@@ -270,7 +270,7 @@ class CholmodSolver final : public LinearSolver {
     a.s = static_cast<const Index*>(L_->s);
     a.x = static_cast<const double*>(L_->x);
     a.perm = static_cast<const Index*>(L_->Perm);
-    sp_.assign(a);
+    sp_.assign(a);  // false (sp_ stays empty, double solves) if the factor does not fit in float
   }
 
   mutable cholmod_common cc_{};

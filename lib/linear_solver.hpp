@@ -82,8 +82,9 @@ class LinearSolver {
   // the factor (made at each factorize()), which halves the memory traffic of a solve; the factorization and
   // all arithmetic stay double, but a solve is then accurate to ~1e-7·cond(A) only: meant for modified Newton,
   // whose kept matrix is an approximation anyway. Returns false (and keeps double solves) where the back-end
-  // cannot: only "cholmod" can, and only while its factor is supernodal LLᵀ (after a fallback to simplicial
-  // LDLᵀ its solves are double again; stats().single_solves counts the solves really done in single).
+  // cannot: only "cholmod" can, and only while its factor is supernodal LLᵀ and fits in float (after a fallback to
+  // simplicial LDLᵀ, or with entries beyond ~3.4e38, its solves are double; stats().single_solves counts the
+  // solves really done in single).
   virtual bool set_single_precision_solves(bool on) { return !on; }
 
   // Counters and process-independent wall times (std::chrono::steady_clock) in seconds.

@@ -2,6 +2,7 @@
 #include "lib/single_precision_factor.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <stdexcept>
 #include <string>
 
@@ -15,7 +16,7 @@ void SinglePrecisionFactor::clear() {
   values_.clear();
 }
 
-void SinglePrecisionFactor::assign(const Arrays& a) {
+bool SinglePrecisionFactor::assign(const Arrays& a) {
   clear();
   if (a.n <= 0 || a.nsuper <= 0 || !a.super || !a.pi || !a.px || !a.s || !a.x)
     throw std::invalid_argument("SinglePrecisionFactor: empty or incomplete supernodal factor");
@@ -34,6 +35,16 @@ void SinglePrecisionFactor::assign(const Arrays& a) {
     }
     // The block's ncol columns of nrow entries each (CHOLMOD may pad px; the padding is not copied).
     values_.insert(values_.end(), a.x + a.px[k], a.x + a.px[k] + nrow * ncol);
+    for (Index p = b.vals; p < b.vals + nrow * ncol; ++p)
+      if (!std::isfinite(values_[static_cast<size_t>(p)])) {
+        clear();
+        return false;
+      }
+    for (Index j = 0; j < ncol; ++j)
+      if (values_[static_cast<size_t>(b.vals + j * nrow + j)] == 0.0f) {
+        clear();
+        return false;
+      }
     blocks_.push_back(b);
     max_rows = std::max(max_rows, nrow);
   }
@@ -41,6 +52,7 @@ void SinglePrecisionFactor::assign(const Arrays& a) {
   n_ = a.n;
   y_.assign(static_cast<size_t>(n_), 0.0);
   w_.assign(static_cast<size_t>(max_rows), 0.0);
+  return true;
 }
 
 namespace {

@@ -37,8 +37,10 @@ class SinglePrecisionFactor {
     const Index* perm = nullptr;   // fill-reducing permutation (row k of L is row perm[k] of A); null: identity
   };
 
-  // Copies the structure and rounds the values to float. Throws std::invalid_argument on inconsistent arrays.
-  void assign(const Arrays& a);
+  // Copies the structure and rounds the values to float. Returns false (and stays empty) if a value does not fit:
+  // beyond float's range (~3.4e38) or a pivot that rounds to zero; the caller then keeps double solves. Throws
+  // std::invalid_argument on inconsistent arrays.
+  bool assign(const Arrays& a);
   bool empty() const { return n_ == 0; }
   void clear();
 

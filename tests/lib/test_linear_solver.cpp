@@ -327,6 +327,17 @@ TEST(LinearSolver, SinglePrecisionSolvesOnlyWithCholmodSupernodal) {
   EXPECT_LT(relative_residual(B.view(), x, c), 1e-9);
   EXPECT_EQ(s->stats().single_solves, 0);
   EXPECT_EQ(s->stats().analyses, 2);  // the LDLᵀ fallback re-analysed
+  // A factor beyond float's range (entries ~1e45) keeps double solves instead of producing inf.
+  SparseMatrix C = shell_like_matrix(3, 34);
+  for (double& v : C.values) v *= 1e90;
+  auto big = make_linear_solver("cholmod");
+  ASSERT_TRUE(big->set_single_precision_solves(true));
+  big->factorize(C.view());
+  const auto d = random_vector(C.pattern->n, 35);
+  std::vector<double> xd(d.size());
+  big->solve(d.data(), xd.data());
+  EXPECT_LT(relative_residual(C.view(), xd, d), 1e-12);
+  EXPECT_EQ(big->stats().single_solves, 0);
   EXPECT_FALSE(single_precision_setting("double", "klu", "em-galpha"));
   EXPECT_TRUE(single_precision_setting("single", "cholmod", "em-galpha"));
   for (const auto& [value, solver, expect] :
