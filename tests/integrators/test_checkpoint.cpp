@@ -203,6 +203,12 @@ TEST(CheckpointNewmark, EmGalphaModifiedNewtonDefaultsContinueBitwise) {
   // cc_tol out of reach: the energy floor (or the step test) ends every iteration.
   expect_bitwise_continuation("em-galpha", {{"newton", "modified"}, {"cc_tol", "1e-30"}}, 7);
 }
+TEST(CheckpointNewmark, SinglePrecisionSolvesContinueBitwise) {
+  // solve_precision = single (docs/dependencies.md §5.5): the replayed K̄ is factorized and copied to float again,
+  // which must give the same float factor, hence the same corrections.
+  expect_bitwise_continuation("em-galpha", {{"newton", "modified"}, {"solve_precision", "single"}}, 7);
+  expect_bitwise_continuation("em-exact", {{"newton", "modified"}, {"setup_every", "2"}, {"solve_precision", "single"}}, 3);
+}
 TEST(CheckpointNewmark, EmGalphaFullNewtonContinuesBitwise) { expect_bitwise_continuation("em-galpha", {}, 5); }
 TEST(CheckpointNewmark, GalphaContinuesBitwise) { expect_bitwise_continuation("galpha", {{"rho_inf", "0.8"}}, 5); }
 TEST(CheckpointNewmark, MidpointContinuesBitwise) { expect_bitwise_continuation("midpoint", {}, 5); }
