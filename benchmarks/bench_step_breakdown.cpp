@@ -6,9 +6,10 @@
 // Integrates the case with its integrator (settings from the case, overridden by --set/--integrator/--dt),
 // first without measuring up to --from, then --steps steps with lib/profile.hpp switched on, and prints
 // one row per instrumented section: process CPU ms per call (all threads), calls per step, CPU ms per
-// step and share of the step's CPU time. The row "Newton overhead (rest)" is the step's CPU time not
-// covered by any section: KINSOL, vector copies, the predictor, chart checks. CPU time is measured, so
-// the numbers are meaningful on a loaded machine; wall time is printed for the whole window.
+// step and share of the step's CPU time, then wall ms per step and share of the step's wall time. The row
+// "Newton overhead (rest)" is the step's time not covered by any section: KINSOL, vector copies, the
+// predictor, chart checks. CPU time is meaningful on a loaded machine; the wall columns show, with several
+// threads, which pieces run on one (their wall time equals their CPU time) and what they cost in elapsed time.
 #include "integrators/integrator.hpp"
 #include "integrators/runs/registry.hpp"
 #include "lib/profile.hpp"
@@ -116,20 +117,25 @@ int main(int argc, char** argv) {
                 ", %ld rejected attempts, %ld chart switches\n",
                 double(rep.nonlinear_iterations) / ns, double(rep.factorizations) / ns, double(rep.rhs_evaluations) / ns,
                 double(rep.linear_setups) / ns, rep.rejected_steps, rep.chart_switches);
-    std::printf("\n| piece | CPU ms per call | calls per step | CPU ms per step | share |\n|---|---|---|---|---|\n");
-    double covered = 0;
+    std::printf("\n| piece | CPU ms per call | calls per step | CPU ms per step | share | wall ms per step | wall share |\n"
+                "|---|---|---|---|---|---|---|\n");
+    double covered = 0, covered_wall = 0;
     for (int i = 0; i < profile::kSections; ++i) {
       const auto sec = static_cast<profile::Section>(i);
       const profile::Totals t = profile::totals(sec);
       if (t.calls == 0) continue;
       covered += t.cpu_s;
-      std::printf("| %s | %.3f | %.2f | %.3f | %.1f %% |\n", profile::name(sec), 1e3 * t.cpu_s / double(t.calls),
-                  double(t.calls) / ns, 1e3 * t.cpu_s / ns, 100.0 * t.cpu_s / cpu);
+      covered_wall += t.wall_s;
+      std::printf("| %s | %.3f | %.2f | %.3f | %.1f %% | %.3f | %.1f %% |\n", profile::name(sec),
+                  1e3 * t.cpu_s / double(t.calls), double(t.calls) / ns, 1e3 * t.cpu_s / ns, 100.0 * t.cpu_s / cpu,
+                  1e3 * t.wall_s / ns, 100.0 * t.wall_s / wall);
     }
-    std::printf("| Newton overhead (rest) | | | %.3f | %.1f %% |\n", 1e3 * (cpu - covered) / ns, 100.0 * (cpu - covered) / cpu);
-    std::printf("| **step** | | | **%.3f** | 100 %% |\n", 1e3 * cpu / ns);
-    std::printf("\nwindow: %.3f s CPU, %.3f s wall (CPU/wall %.2f); extrapolated to %.0f steps: %.1f s CPU\n", cpu, wall,
-                cpu / wall, p.spec.time.t_end / dt, cpu / ns * (p.spec.time.t_end / dt));
+    std::printf("| Newton overhead (rest) | | | %.3f | %.1f %% | %.3f | %.1f %% |\n", 1e3 * (cpu - covered) / ns,
+                100.0 * (cpu - covered) / cpu, 1e3 * (wall - covered_wall) / ns, 100.0 * (wall - covered_wall) / wall);
+    std::printf("| **step** | | | **%.3f** | 100 %% | **%.3f** | 100 %% |\n", 1e3 * cpu / ns, 1e3 * wall / ns);
+    std::printf("\nwindow: %.3f s CPU, %.3f s wall (CPU/wall %.2f); extrapolated to %.0f steps: %.1f s CPU, %.1f s wall\n",
+                cpu, wall, cpu / wall, p.spec.time.t_end / dt, cpu / ns * (p.spec.time.t_end / dt),
+                wall / ns * (p.spec.time.t_end / dt));
     return 0;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "bench_step_breakdown: %s\n", e.what());
