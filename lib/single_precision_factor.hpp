@@ -47,9 +47,6 @@ class SinglePrecisionFactor {
   // x = (P ᵀ L̂ L̂ᵀ P)⁻¹ b. x may alias b.
   void solve(const double* b, double* x) const;
 
-  // Bytes of the stored factor values (float), for reports.
-  size_t value_bytes() const { return values_.size() * sizeof(float); }
-
  private:
   struct Block {
     Index col0, ncol, nrow;  // first column, columns, rows (ncol of them in the triangle)
