@@ -10,8 +10,9 @@ stopped once history.csv has passed half of the end time (t_end is read from the
   MODE = term      SIGTERM (exit code 143, likewise)
   MODE = maxsteps  --max-steps N given in RUN_ARGS (exit code 4, run.json "stopped: ...")
 then `SHELLDYN resume WORK_DIR/cut` and requires:
-  - resume exits 0 and run.json says "complete" with no checkpoint and no run.json.reserve left (a SIGKILL
-    leaves the reserve; an orderly stop must not);
+  - resume exits 0 and run.json says "complete" with no checkpoint, no run.json.reserve and no *.tmp left
+    (a SIGKILL leaves the reserve and possibly a temporary, planted here if it did not; an orderly stop must
+    leave neither);
   - history.csv of the resumed run equals the reference row for row, in every column but wall_s,
     as text (the numbers are written with 17 digits: equal text = equal doubles, bitwise);
   - fields.pvd lists the same times and files as the reference.
@@ -99,8 +100,24 @@ def main():
         fail(f"expected one line on stderr, got: {err!r}")
     if not os.path.exists(os.path.join(cut, "checkpoint.cbor")):
         fail("no checkpoint.cbor after the interruption")
-    if [f for f in os.listdir(cut) if f.endswith(".tmp")]:
-        fail("a .tmp file was left behind: " + str(os.listdir(cut)))
+    # An orderly stop leaves no temporary. A SIGKILL can land while an output's temporary is being written
+    # (run.json.tmp, fields.pvd.tmp, checkpoint.cbor.tmp are written whole, then renamed); resume must clear
+    # such leftovers. So that this is checked on every run, not only when the kill happens to land mid-write,
+    # plant one of each where the kill left none.
+    def temporaries():
+        found = [f for f in os.listdir(cut) if f.endswith(".tmp")]
+        fields = os.path.join(cut, "fields")
+        if os.path.isdir(fields):
+            found += ["fields/" + f for f in os.listdir(fields) if f.endswith(".tmp")]
+        return found
+    if mode != "kill" and temporaries():
+        fail("a .tmp file was left behind: " + str(temporaries()))
+    if mode == "kill":
+        for name in ("run.json.tmp", "fields.pvd.tmp", "checkpoint.cbor.tmp"):
+            path = os.path.join(cut, name)
+            if not os.path.exists(path):
+                with open(path, "w") as f:
+                    f.write("<half-written")
     cut_t = last_t(os.path.join(cut, "history.csv"))
     ckpt_t = info.get("checkpoint", {}).get("t")
     # The disk reserve (room for the last run.json on a full disk) survives only a SIGKILL; an orderly stop
@@ -121,6 +138,8 @@ def main():
         fail("checkpoint.cbor left after the run completed")
     if os.path.exists(reserve):
         fail("run.json.reserve left after the resumed run completed")
+    if temporaries():
+        fail("a .tmp file was left behind after the resume: " + str(temporaries()))
     h2, cut_rows = rows(os.path.join(cut, "history.csv"))
     if h2 != header:
         fail("history.csv headers differ")
