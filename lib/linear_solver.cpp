@@ -82,6 +82,20 @@ void limit_blas_threads() {
   if (set) set(1);
 }
 
+}  // namespace
+
+std::string blas_description() {
+  using GetString = char* (*)();
+  static const auto config = reinterpret_cast<GetString>(dlsym(RTLD_DEFAULT, "openblas_get_config"));
+  static const auto core = reinterpret_cast<GetString>(dlsym(RTLD_DEFAULT, "openblas_get_corename"));
+  if (!config) return "unknown (not OpenBLAS)";
+  std::string d = config();  // with DYNAMIC_ARCH it names the core chosen at load time
+  if (core && d.find(core()) == std::string::npos) d += std::string(" (core: ") + core() + ")";
+  return d;
+}
+
+namespace {
+
 template <class F>
 void single_threaded(const F& f) {
   if (omp_in_parallel()) {  // already inside a region: CHOLMOD's regions nest and stay inactive

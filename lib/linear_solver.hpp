@@ -110,6 +110,13 @@ bool is_linear_solver_name(const std::string& name);
 // with a back-end that cannot do it (only "cholmod" can).
 bool single_precision_setting(const std::string& value, const std::string& linear_solver, const std::string& who);
 
+// The BLAS the sparse factorizations run on, for run.json: with OpenBLAS its build configuration and the kernel
+// set it chose for this CPU at load time, e.g. "OpenBLAS 0.3.21 NO_LAPACKE DYNAMIC_ARCH NO_AFFINITY Prescott
+// MAX_THREADS=64". The kernels set the summation order inside CHOLMOD's supernodal factorization and solves,
+// so two machines whose cores differ give results that differ at round-off (docs/dependencies.md §5.6).
+// "unknown (not OpenBLAS)" when the loaded BLAS is another one.
+std::string blas_description();
+
 // Structural checks shared by the back-ends (and useful to callers): n > 0, colptr[0] == 0,
 // non-decreasing colptr, row indices in [0, n) and strictly increasing within each column.
 // Throws std::invalid_argument naming `who`, the column and the problem.

@@ -1,5 +1,7 @@
 #include "lib/run_info.hpp"
 
+#include "lib/linear_solver.hpp"
+
 #include <Eigen/Core>
 #include <nlohmann/json.hpp>
 
@@ -129,6 +131,7 @@ std::string run_json(const CaseSpec& c, const RunInfo& info) {
   v["eigen"] = eigen_version();
   v["nlohmann_json"] = std::to_string(NLOHMANN_JSON_VERSION_MAJOR) + "." + std::to_string(NLOHMANN_JSON_VERSION_MINOR) +
                        "." + std::to_string(NLOHMANN_JSON_VERSION_PATCH);
+  v["blas"] = blas_description();  // its kernels set the round-off of the factorizations (docs/dependencies.md §5.6)
 #ifdef __VERSION__
   v["compiler"] = __VERSION__;
 #endif

@@ -68,6 +68,8 @@ def main():
         fail(f"run.json: discretization {disc}")
     if not info.get("versions", {}).get("shelldyn"):
         fail("run.json: versions.shelldyn missing")
+    if not info.get("versions", {}).get("blas"):  # its kernels set the round-off (docs/dependencies.md §5.6)
+        fail("run.json: versions.blas missing")
     print(f"OK: {out}: {npts} points, {ncells} quad9 cells (VTK 28), pvd and run.json valid")
 
 
