@@ -2,6 +2,10 @@
 """A case file's Newton settings reproduce the converged scheme (docs/results.md §2.1).
 
 usage: check_converged_settings.py WORK_DIR TOL MONITOR -- APP ARGS...
+example: python3 scripts/check_converged_settings.py /tmp/conv 3e-11 uzC --
+             build/bin/shelldyn run apps/cases/cylindrical-panel.yaml --t-end 0.03 --vtu-every 0 -q
+(APP ARGS: a `shelldyn run CASE ...` or a benchmark app command line without -o; MONITOR: a monitor column of
+the case's history.csv. Exit 0 if both distances are within TOL, 1 if not or if a run fails, 2 on bad usage.)
 
 Runs APP ARGS twice: as given (the case file's settings) into WORK_DIR/case, and with the iteration driven
 much deeper (`--set floor_test=correction --set e_floor=1e-26 --set cc_tol=1e-30`, each step iterated until
@@ -30,9 +34,24 @@ def history(path):
         return list(csv.DictReader(f))
 
 
+def usage(msg):
+    print("error: " + msg, file=sys.stderr)
+    print("usage: check_converged_settings.py WORK_DIR TOL MONITOR -- APP ARGS...  (--help for more)", file=sys.stderr)
+    sys.exit(2)
+
+
 def main():
+    if len(sys.argv) > 1 and sys.argv[1] in ("-h", "--help"):
+        print(__doc__)
+        return
+    if "--" not in sys.argv or sys.argv.index("--") != 4 or len(sys.argv) < 6:
+        usage("expected WORK_DIR TOL MONITOR, then --, then the command to run")
     sep = sys.argv.index("--")
-    work, tol, monitor = sys.argv[1], float(sys.argv[2]), sys.argv[3]
+    work, monitor = sys.argv[1], sys.argv[3]
+    try:
+        tol = float(sys.argv[2])
+    except ValueError:
+        usage(f"TOL {sys.argv[2]!r} is not a number (e.g. 3e-11)")
     cmd = sys.argv[sep + 1:]
     if os.path.isdir(work):
         shutil.rmtree(work)
