@@ -349,17 +349,13 @@ int run_resume(const RunCommandOptions& o) {
   check_run_flags(o);
   const std::string dir = o.case_path;
   const Checkpoint c = read_checkpoint((fs::path(dir) / checkpoint_file_name()).string());
-  // A run killed with SIGKILL leaves its disk reserve (lib/run_info.hpp DiskReserve) behind: stale, remove it
-  // (the resumed run allocates its own and deletes it at the end, whatever the outcome).
-  // A SIGKILL during the write of an output leaves its temporary as well (run.json.tmp, fields.pvd.tmp,
-  // checkpoint.cbor.tmp: each is written whole and then renamed over the real file); the complete file from
-  // before is still in place, so the temporary is garbage: remove it too.
+  // A run killed with SIGKILL leaves its disk reserve (lib/run_info.hpp DiskReserve) behind, and possibly the
+  // temporary of an output it was rewriting (run.json, fields.pvd and checkpoint.cbor are written whole to
+  // NAME.tmp, then renamed; the complete file from before is still in place). Both are stale: remove them (the
+  // resumed run allocates its own reserve and deletes it at the end, whatever the outcome).
   std::error_code ec;
   for (const char* stale : {"run.json.reserve", "run.json.tmp", "fields.pvd.tmp", "checkpoint.cbor.tmp"})
     fs::remove(fs::path(dir) / stale, ec);
-  if (fs::is_directory(fs::path(dir) / "fields", ec))
-    for (const auto& e : fs::directory_iterator(fs::path(dir) / "fields", ec))
-      if (e.path().extension() == ".tmp") fs::remove(e.path(), ec);
   Problem problem = problem_from_checkpoint(c);
   RunOptions ro = run_options_from_checkpoint(c);
   ro.out_dir = dir;
