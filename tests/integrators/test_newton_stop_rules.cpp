@@ -168,14 +168,13 @@ PlateRun run_flying_plate(std::vector<std::pair<std::string, std::string>> setti
 // against iterating to round-off, on the flying plate's first 0.4 s (apps/cases/flying-plate.yaml, loads
 // acting): fewer iterations, the same solution and energy balance to far below the discretisation error.
 TEST(NewtonStopRules, EstimatedFloorTestSavesIterationsAtTheSameSolution) {
-  using Totals = PlateRun;
   const double dt = 1e-3;
   const int steps = 400;
   auto run = [&](std::vector<std::pair<std::string, std::string>> settings) { return run_flying_plate(settings, dt, steps); };
-  const Totals ref = run({{"e_floor", "1e-30"}, {"cc_tol", "1e-30"}});  // iterated to round-off
-  const Totals corr = run({{"floor_test", "correction"}});
-  const Totals est = run({});  // default: floor_test = estimate
-  auto balance_gap = [&](const Totals& t) {  // largest difference of K + V − W from the round-off run's, / (K + V)
+  const PlateRun ref = run({{"e_floor", "1e-30"}, {"cc_tol", "1e-30"}});  // iterated to round-off
+  const PlateRun corr = run({{"floor_test", "correction"}});
+  const PlateRun est = run({});  // default: floor_test = estimate
+  auto balance_gap = [&](const PlateRun& t) {  // largest difference of K + V − W from the round-off run's, / (K + V)
     double gap = 0.0;
     for (size_t k = 0; k < t.balance.size(); ++k) gap = std::max(gap, std::abs(t.balance[k] - ref.balance[k]));
     return gap / ref.energy;
@@ -186,7 +185,7 @@ TEST(NewtonStopRules, EstimatedFloorTestSavesIterationsAtTheSameSolution) {
               (corr.u - ref.u).norm() / ref.u.norm(), (est.u - ref.u).norm() / ref.u.norm(), balance_gap(corr),
               balance_gap(est), std::abs(*std::max_element(ref.balance.begin(), ref.balance.end(),
                                                           [](double a, double b) { return std::abs(a) < std::abs(b); })) / ref.energy);
-  for (const Totals* t : {&corr, &est}) {
+  for (const PlateRun* t : {&corr, &est}) {
     EXPECT_EQ(t->rep.steps, steps);
     EXPECT_EQ(t->rep.rejected_steps, 0);
     EXPECT_LT((t->u - ref.u).norm(), 1e-10 * ref.u.norm());
