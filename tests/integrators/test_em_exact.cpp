@@ -273,8 +273,11 @@ TEST(EmExact, DissipationIsNonPositiveAndAccountedFor) {
     EXPECT_GE(r.min_step_dissipation, 0.0);   // the dissipation term ξ ΔuᵀGΔu is non-negative
     EXPECT_LT(r.final_dH, -1e-3);             // and it does remove energy
     EXPECT_LT(r.max_balance, 1e-10);          // K + V + D is conserved exactly
-    EXPECT_LT(r.max_dL, 1e-12);               // momenta stay exact: G is orthogonal to the rigid modes
-    EXPECT_LT(r.max_dJ, 1e-9);
+    // Momenta stay exact: G is orthogonal to the rigid modes. Measured 7.6e-14 / 7.3e-14 (ΔL) and 1.6e-14 /
+    // 1.3e-14 (ΔJ) with ξ G Δu applied as a chain of products; forming G first and multiplying gave
+    // 4.8e-13–1.04e-12 and 1.7e-13–1.9e-13 (its rounding scales with |G| |Δu|, Δu mostly rigid), which fails here.
+    EXPECT_LT(r.max_dL, 4e-13);
+    EXPECT_LT(r.max_dJ, 1e-13);
   }
 }
 
