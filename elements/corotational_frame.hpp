@@ -72,7 +72,7 @@ class CorotationalFrame {
     if (!have_derivatives_) compute_derivatives();
   }
   void compute_derivatives() const;
-  // The corner columns C of T (apply_transpose(), tangent(), matrix()).
+  // The corner columns C of T (tangent(), matrix(); apply_transpose() contracts them without forming C).
   void corner_columns() const {
     derivatives();
     if (!have_corner_columns_) compute_corner_columns();

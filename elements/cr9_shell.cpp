@@ -232,9 +232,28 @@ CR9Shell::CR9Shell(const std::array<Eigen::Vector3d, 9>& X0, const std::array<Ei
     }
   for (int j = 0; j < 45; ++j)
     for (int i = 0; i <= j; ++i) Kbsp_(i + j * (j + 1) / 2) = Kbs_(i, j);
+  std::vector<int> active;
+  for (int i = 0; i < 45; ++i)
+    if ((Kbs_.row(i).array() != 0.0).any()) active.push_back(i);
+  if (active.size() < 45) {
+    kbs_active_ = active;
+    const Eigen::Index na = static_cast<Eigen::Index>(active.size());
+    kbs_block_.resize(na, na);
+    for (Eigen::Index j = 0; j < na; ++j)
+      for (Eigen::Index i = 0; i < na; ++i) kbs_block_(i, j) = Kbs_(active[static_cast<size_t>(i)], active[static_cast<size_t>(j)]);
+  }
 }
 
 CR9Shell::Vec45 CR9Shell::kbs_times(const Vec45& w) const {
+  if (!kbs_active_.empty()) {  // flat element: the dense block on the DOFs K_bs acts on
+    const Eigen::Index na = kbs_block_.rows();
+    Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 45, 1> wa(na), ya(na);
+    for (Eigen::Index k = 0; k < na; ++k) wa(k) = w(kbs_active_[static_cast<size_t>(k)]);
+    ya.noalias() = kbs_block_ * wa;
+    Vec45 y = Vec45::Zero();
+    for (Eigen::Index k = 0; k < na; ++k) y(kbs_active_[static_cast<size_t>(k)]) = ya(k);
+    return y;
+  }
   // Symmetric packed product: column j of the upper triangle contributes K_ij w_j to y_i (i < j) and
   // Σ_{i≤j} K_ij w_i to y_j.
   Vec45 y;
@@ -275,6 +294,20 @@ CorotationalFrame CR9Shell::frame(const Vec45& u, const Charts& charts) const {
   return local_increments(u, charts, nullptr);
 }
 
+Eigen::Matrix<double, 27, 1> CR9Shell::membrane_strains(const Mat39& t) const {
+  // ε_m,c at every Gauss point: L_m,c·t + ½ Σ_ij H_c(i,j) t_i·t_j = L_m,c·t + ½ H_c : (tᵀt)  (§4.5)
+  // Packed Gram matrix with the off-diagonal entries doubled: Σ_ij H_ij G_ij = Σ_k Hp_k g_k.
+  Eigen::Matrix<double, 45, 1> g;
+  for (int j = 0; j < 9; ++j) {
+    for (int i = 0; i < j; ++i) g(i + j * (j + 1) / 2) = 2.0 * t.col(i).dot(t.col(j));
+    g(j + j * (j + 1) / 2) = t.col(j).squaredNorm();
+  }
+  const Eigen::Map<const Eigen::Matrix<double, 27, 1>> v(t.data());
+  Eigen::Matrix<double, 27, 1> e = Lall_.lazyProduct(v);
+  e.noalias() += 0.5 * Hp_.transpose().lazyProduct(g);
+  return e;
+}
+
 double CR9Shell::membrane(const Mat39& t1, const Mat39& t0, double c1, double c0, double b1, double b0, Vec45* fL,
                           Mat45* kL, const StepState* n0) const {
   const Eigen::Matrix3d hD1 = mat_.thickness * D1_;
@@ -282,28 +315,25 @@ double CR9Shell::membrane(const Mat39& t1, const Mat39& t0, double c1, double c0
   Eigen::Matrix<double, 27, 27> km;
   Mat9 Hs;
   if (kL) km.setZero(), Hs.setZero();
-  const Eigen::Map<const Eigen::Matrix<double, 27, 1>> v1(t1.data()), v0(t0.data());
+  const bool need0 = (c0 != 0.0 || b0 != 0.0);
+  const Eigen::Matrix<double, 27, 1> e1all = membrane_strains(t1);
+  Eigen::Matrix<double, 27, 1> e0all = Eigen::Matrix<double, 27, 1>::Zero();
+  if (need0 && n0)
+    for (int g = 0; g < 9; ++g) e0all.segment<3>(3 * g) = n0->e[static_cast<size_t>(g)];
+  else if (need0)
+    e0all = membrane_strains(t0);
   double U = 0.0;
   for (size_t g = 0; g < gp_.size(); ++g) {
     const GaussPoint& gp = gp_[g];
-    // ε_m,c = L_m,c·t + ½ Σ_ij H_c(i,j) t_i·t_j (quadratic, §4.7); gradient B_m = L_m + H_m t.
-    Eigen::Vector3d e1, e0 = Eigen::Vector3d::Zero();
+    // Gradient B_m = L_m + H_m t̄ at t̄ = b1 t1 + b0 t0 (§4.7), linear in t̄: t̄H from t1H and t0H.
+    const Eigen::Vector3d e1 = e1all.segment<3>(3 * static_cast<int>(g)), e0 = e0all.segment<3>(3 * static_cast<int>(g));
     Eigen::Matrix<double, 3, 27> Bm;
     // lazyProduct: these small fixed-size products (3×9·9×9, 27×3·3×27) are 2-3x faster coefficient-wise
-    // than through Eigen's blocked GEMM path, which it picks when rows + cols + depth > 20. The gradient at
-    // t̄ = b1 t1 + b0 t0 is linear in t̄, so t̄H is combined from t1H and t0H without a third product.
-    const bool need0 = (c0 != 0.0 || b0 != 0.0);
+    // than through Eigen's blocked GEMM path, which it picks when rows + cols + depth > 20.
     for (int c = 0; c < 3; ++c) {
       const Mat39 tH1 = t1.lazyProduct(gp.Hm[c]);
-      e1(c) = gp.Lm.row(c).dot(v1) + 0.5 * tH1.cwiseProduct(t1).sum();
-      if (need0 && n0) {  // t0's strain and products from the step state (same arithmetic)
-        e0(c) = n0->e[g](c);
-        const Mat39 tHb = b1 * tH1 + b0 * n0->tH[g][static_cast<size_t>(c)];
-        Bm.row(c) = gp.Lm.row(c) + Eigen::Map<const Row27>(tHb.data());
-      } else if (need0) {
-        const Mat39 tH0 = t0.lazyProduct(gp.Hm[c]);
-        e0(c) = gp.Lm.row(c).dot(v0) + 0.5 * tH0.cwiseProduct(t0).sum();
-        const Mat39 tHb = b1 * tH1 + b0 * tH0;
+      if (need0) {
+        const Mat39 tHb = b1 * tH1 + b0 * t0.lazyProduct(gp.Hm[c]);
         Bm.row(c) = gp.Lm.row(c) + Eigen::Map<const Row27>(tHb.data());
       } else {
         Bm.row(c) = gp.Lm.row(c) + b1 * Eigen::Map<const Row27>(tH1.data());
@@ -332,16 +362,7 @@ double CR9Shell::membrane(const Mat39& t1, const Mat39& t0, double c1, double c0
 double CR9Shell::membrane_force(const Mat39& t1, const Mat39& t0, double c1, double c0, double b1, double b0,
                                 const StepState& n0, Vec45* fL) const {
   const Eigen::Matrix3d hD1 = mat_.thickness * D1_;
-  const Eigen::Map<const Eigen::Matrix<double, 27, 1>> v1(t1.data());
-  // ε_m,c at every Gauss point: L_m,c·t + ½ Σ_ij H_c(i,j) t_i·t_j = L_m,c·t + ½ H_c : (tᵀt)  (§4.5)
-  // Packed Gram matrix with the off-diagonal entries doubled: Σ_ij H_ij G_ij = Σ_k Hp_k g_k.
-  Eigen::Matrix<double, 45, 1> g;
-  for (int j = 0; j < 9; ++j) {
-    for (int i = 0; i < j; ++i) g(i + j * (j + 1) / 2) = 2.0 * t1.col(i).dot(t1.col(j));
-    g(j + j * (j + 1) / 2) = t1.col(j).squaredNorm();
-  }
-  Eigen::Matrix<double, 27, 1> e1 = Lall_ * v1;
-  e1.noalias() += 0.5 * (Hp_.transpose() * g);
+  const Eigen::Matrix<double, 27, 1> e1 = membrane_strains(t1);
   // N* = h D1 (c1 ε1 + c0 ε0) per Gauss point (§6.3), weighted by dA: s = dA N*.
   Eigen::Matrix<double, 27, 1> sN;
   double U = 0.0;
@@ -353,8 +374,8 @@ double CR9Shell::membrane_force(const Mat39& t1, const Mat39& t0, double c1, dou
     sN.segment<3>(3 * g) = dA * N;
   }
   // Σ_gp dA B_mᵀ N with B_m,c = L_m,c + (t̄ H_c) rows, t̄ = b1 t1 + b0 t0: Lᵀ s + t̄ Σ_gp,c s_gp,c H_c.
-  Eigen::Matrix<double, 27, 1> fm = Lall_.transpose() * sN;
-  const Eigen::Matrix<double, 45, 1> hs = Hp_ * sN;
+  Eigen::Matrix<double, 27, 1> fm = Lall_.transpose().lazyProduct(sN);
+  const Eigen::Matrix<double, 45, 1> hs = Hp_.lazyProduct(sN);
   Mat9 Hs;
   for (int j = 0; j < 9; ++j)
     for (int i = 0; i <= j; ++i) Hs(i, j) = Hs(j, i) = hs(i + j * (j + 1) / 2);
@@ -435,14 +456,8 @@ double CR9Shell::algorithmic_internal(const Vec45& u_n, const Vec45& u_np1, cons
 void CR9Shell::step_state(const Vec45& u_n, const Charts& charts, StepState* st) const {
   local_increments(u_n, charts, &st->w, false);
   st->Kw = kbs_times(st->w);
-  const Mat39 t0 = translations(st->w);
-  const Eigen::Map<const Eigen::Matrix<double, 27, 1>> v0(t0.data());
-  for (size_t g = 0; g < gp_.size(); ++g)
-    for (int c = 0; c < 3; ++c) {  // the expressions of membrane(), so that results are bitwise the same
-      Mat39& tH0 = st->tH[g][static_cast<size_t>(c)];
-      tH0 = t0.lazyProduct(gp_[g].Hm[c]);
-      st->e[g](c) = gp_[g].Lm.row(c).dot(v0) + 0.5 * tH0.cwiseProduct(t0).sum();
-    }
+  const Eigen::Matrix<double, 27, 1> e = membrane_strains(translations(st->w));  // membrane()'s strains, bitwise
+  for (int g = 0; g < 9; ++g) st->e[static_cast<size_t>(g)] = e.segment<3>(3 * g);
 }
 
 double CR9Shell::step_energy(const StepState& st) const {
@@ -462,7 +477,7 @@ double CR9Shell::algorithmic_internal(const StepState& sn, const Vec45& u_n, con
        << " must be finite";
     throw std::invalid_argument(os.str());
   }
-  // As the plain overload, with w_n, ε_m(t_n) and t_n H_m from the step state.
+  // As the plain overload, with w_n, K_bs w_n and ε_m(t_n) from the step state.
   const Vec45& wn = sn.w;
   Vec45 w1;
   local_increments(u_np1, charts, &w1, false);  // the frame at u_np1 serves w1 only (its derivatives are never formed)

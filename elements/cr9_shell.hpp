@@ -23,6 +23,7 @@
 
 #include <Eigen/Core>
 #include <array>
+#include <vector>
 
 #include "elements/corotational_frame.hpp"
 #include "elements/director.hpp"
@@ -65,14 +66,13 @@ class CR9Shell {
                               double xi, Vec45* F, Mat45* K) const;
 
   // What §6.3 needs from the step's start configuration u_n, which is fixed during a step's Newton
-  // iterations: the local increments w_n and, per Gauss point, the membrane strains ε_m(t_n) and the
-  // products t_n H_m,c. Computed once per step (step_state()), used by every residual and tangent of the
-  // step (the overload of algorithmic_internal below), with results identical to the plain overload.
+  // iterations: the local increments w_n, K_bs w_n and the membrane strains ε_m(t_n) per Gauss point.
+  // Computed once per step (step_state()), used by every residual and tangent of the step (the overload of
+  // algorithmic_internal below), with results identical to the plain overload.
   struct StepState {
     Vec45 w;
-    Vec45 Kw;                                                  // K_bs w_n (bending + shear force at t_n)
-    std::array<Eigen::Vector3d, 9> e;                          // ε_m at t_n per Gauss point
-    std::array<std::array<Eigen::Matrix<double, 3, 9>, 3>, 9> tH;  // t_n H_m,c per Gauss point and c
+    Vec45 Kw;                          // K_bs w_n (bending + shear force at t_n)
+    std::array<Eigen::Vector3d, 9> e;  // ε_m at t_n per Gauss point
   };
   void step_state(const Vec45& u_n, const Charts& charts, StepState* st) const;
   // The strain energy U(u_n) of a step state, with internal()'s expressions (so bitwise internal()'s energy at u_n)
@@ -120,7 +120,7 @@ class CR9Shell {
   // Local response of the membrane part with strains from the local translations t1, t0 weighted by
   // c1, c0 and strain gradient evaluated at t̄ = b1 t1 + b0 t0 (§6.3; internal(): c1 = b1 = 1, c0 = b0 = 0).
   // Adds to fL and kL (t rows only); returns the membrane energy at t1.
-  // With n0 (the step state of t0), its strains and products are taken from there instead of recomputed.
+  // With n0 (the step state of t0), the strains of t0 are taken from there instead of recomputed.
   double membrane(const Mat39& t1, const Mat39& t0, double c1, double c0, double b1, double b0, Vec45* fL,
                   Mat45* kL, const StepState* n0 = nullptr) const;
   // The membrane force alone (kL not wanted), same quantities as membrane() with the step state n0 of t0,
@@ -129,6 +129,10 @@ class CR9Shell {
   // instead of 27 small 3×9·9×9 products). Equal to membrane() to round-off.
   double membrane_force(const Mat39& t1, const Mat39& t0, double c1, double c0, double b1, double b0,
                         const StepState& n0, Vec45* fL) const;
+  // The membrane strains ε_m,c at all Gauss points (entry 3g + c) of the local translations t, through the
+  // Gram matrix: ε = L·t + ½ H:(tᵀt) (§4.5). The one expression for ε everywhere (internal(), the step state,
+  // the residual), so that the energies of the same configuration agree bitwise.
+  Eigen::Matrix<double, 27, 1> membrane_strains(const Mat39& t) const;
   // Local increments w = [t_i, Δθ_i] of u and the frame at u. derivatives = false: a frame for w only (the
   // directors' A1 and d2pl are not evaluated; the frame's derivatives cannot be formed).
   CorotationalFrame local_increments(const Vec45& u, const Charts& charts, Vec45* w, bool derivatives = true) const;
@@ -147,7 +151,12 @@ class CR9Shell {
   Eigen::Matrix<double, 45, 27> Hp_;    // column 3g + c = upper triangle of gp_[g].Hm[c], packed (k = i + j(j+1)/2)
   Eigen::Matrix<double, 27, 1> dAall_;  // entry 3g + c = gp_[g].dA
   Eigen::Matrix<double, 1035, 1> Kbsp_; // upper triangle of Kbs_, packed by columns (k = i + j(j+1)/2)
-  Vec45 kbs_times(const Vec45& w) const;  // Kbs_ w from Kbsp_
+  // A flat element's K_bs is exactly zero on its in-plane translations (the curvatures and transverse shears
+  // of §4.3 do not involve them): K_bs w then runs on the DOFs with a nonzero row only, as a dense block
+  // (27 × 27 instead of the packed 45 × 45; ~4× fewer operations). Empty when every row is nonzero.
+  std::vector<int> kbs_active_;
+  Eigen::MatrixXd kbs_block_;
+  Vec45 kbs_times(const Vec45& w) const;  // Kbs_ w from Kbsp_ or kbs_block_
   Mat45 Kbs_;                           // constant bending + shear stiffness Σ dA (B_b^T M + B_s^T Q)
   std::array<Eigen::Matrix<double, 5, 45>, 9> Bbs_;  // [B_b; B_s] per Gauss point (output only)
   Eigen::Matrix<double, 9, 9> m_;

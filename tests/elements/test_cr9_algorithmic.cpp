@@ -25,7 +25,7 @@ TEST(CR9Algorithmic, ReducesToInternalWhenBothStatesCoincide) {
   }
 }
 
-// The per-step state (w_n, ε_m(t_n), t_n H_m) reproduces the plain overload bitwise: the Model may use
+// The per-step state (w_n, K_bs w_n, ε_m(t_n)) reproduces the plain overload bitwise: the Model may use
 // either without changing any result. A state of another u_n must not (the test can fail).
 TEST(CR9Algorithmic, StepStateOverloadIsBitwiseTheSame) {
   for (Shape shape : {Shape::Flat, Shape::Distorted, Shape::Cylinder}) {

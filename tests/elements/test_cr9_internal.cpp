@@ -204,6 +204,25 @@ TEST_P(CR9Internal, LocalEquilibrium) {
   EXPECT_LT(sum.norm(), 1e-12 * mag);
 }
 
+// §3.3-3.4: apply_transpose() contracts T's corner columns through the frame's weight vectors instead of
+// forming T; it must give T^T f for any f (T dense, from matrix()), to round-off. A sign slip in one corner
+// or a dropped e_z term shows as an O(1) relative error.
+TEST_P(CR9Internal, ApplyTransposeEqualsDenseTTranspose) {
+  for (unsigned seed : {5u, 6u}) {
+    Charts ch;
+    const Vec45 u = random_state(g, 0.08, 1.1 * seed, seed, &ch);
+    const CorotationalFrame fr = elem.frame(u, ch);
+    const Mat45 T = fr.matrix();
+    for (unsigned fs : {11u, 12u}) {
+      const Vec45 f = random_vector(1.0, fs);
+      const Vec45 ref = T.transpose() * f;
+      const double e = (fr.apply_transpose(f) - ref).norm() / ref.norm();
+      std::printf("  [%s seed %u/%u] |apply_transpose(f) - T^T f|/|T^T f| = %.1e\n", g.name.c_str(), seed, fs, e);
+      EXPECT_LT(e, 1e-14);
+    }
+  }
+}
+
 INSTANTIATE_TEST_SUITE_P(Geometries, CR9Internal,
                          ::testing::Combine(::testing::Values(Shape::Flat, Shape::Distorted, Shape::Cylinder),
                                             ::testing::Values(Facing::Z, Facing::X, Facing::Y, Facing::MinusZ)),
