@@ -258,7 +258,15 @@ void CorotationalFrame::tangent(const Mat45& kL, const Vec45& fL, bool geometric
     K->middleRows<3>(5 * i).noalias() = R_.lazyProduct(kT.middleRows<3>(5 * i));
     K->middleRows<2>(5 * i + 3).noalias() = D_theta_[i].transpose().lazyProduct(kT.middleRows<2>(5 * i + 3));
   }
-  const Eigen::Matrix<double, 12, 45> CtkT = C_.transpose() * kT;
+  // Cᵀ(k_L T) = Cᵀ k_L D + (Cᵀ k_L C) P = (k_L C)ᵀ D + (Cᵀ kC) P (k_L symmetric): the block-diagonal D and a
+  // 12 × 12 product instead of a second 12 × 45 · 45 × 45 one.
+  Eigen::Matrix<double, 12, 45> CtkT;
+  for (int j = 0; j < 9; ++j) {
+    CtkT.middleCols<3>(5 * j).noalias() = kC.middleRows<3>(5 * j).transpose().lazyProduct(Rt);
+    CtkT.middleCols<2>(5 * j + 3).noalias() = kC.middleRows<2>(5 * j + 3).transpose().lazyProduct(D_theta_[j]);
+  }
+  const Eigen::Matrix<double, 12, 12> CtkC = C_.transpose() * kC;
+  for (int k = 0; k < 4; ++k) CtkT.middleCols<3>(5 * k) += CtkC.middleCols<3>(3 * k);
   for (int k = 0; k < 4; ++k) K->middleRows<3>(5 * k) += CtkT.middleRows<3>(3 * k);
   if (geometric) add_geometric_stiffness(fL, K);
 }

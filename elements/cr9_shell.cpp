@@ -311,10 +311,6 @@ Eigen::Matrix<double, 27, 1> CR9Shell::membrane_strains(const Mat39& t) const {
 double CR9Shell::membrane(const Mat39& t1, const Mat39& t0, double c1, double c0, double b1, double b0, Vec45* fL,
                           Mat45* kL, const StepState* n0) const {
   const Eigen::Matrix3d hD1 = mat_.thickness * D1_;
-  Eigen::Matrix<double, 27, 1> fm = Eigen::Matrix<double, 27, 1>::Zero();
-  Eigen::Matrix<double, 27, 27> km;
-  Mat9 Hs;
-  if (kL) km.setZero(), Hs.setZero();
   const bool need0 = (c0 != 0.0 || b0 != 0.0);
   const Eigen::Matrix<double, 27, 1> e1all = membrane_strains(t1);
   Eigen::Matrix<double, 27, 1> e0all = Eigen::Matrix<double, 27, 1>::Zero();
@@ -322,40 +318,38 @@ double CR9Shell::membrane(const Mat39& t1, const Mat39& t0, double c1, double c0
     for (int g = 0; g < 9; ++g) e0all.segment<3>(3 * g) = n0->e[static_cast<size_t>(g)];
   else if (need0)
     e0all = membrane_strains(t0);
+  // Gradient B_m = L_m + H_m t̄ at t̄ = b1 t1 + b0 t0 (§4.7), all Gauss points stacked: row 3g + c of Ball.
+  const Mat39 tb = need0 ? Mat39(b1 * t1 + b0 * t0) : Mat39(b1 * t1);
+  Eigen::Matrix<double, 27, 27> Ball, DBall;
+  Eigen::Matrix<double, 27, 1> sN;  // dA N* per Gauss point, N* = h D1 ε*_m (§6.3)
   double U = 0.0;
-  for (size_t g = 0; g < gp_.size(); ++g) {
-    const GaussPoint& gp = gp_[g];
-    // Gradient B_m = L_m + H_m t̄ at t̄ = b1 t1 + b0 t0 (§4.7), linear in t̄: t̄H from t1H and t0H.
-    const Eigen::Vector3d e1 = e1all.segment<3>(3 * static_cast<int>(g)), e0 = e0all.segment<3>(3 * static_cast<int>(g));
-    Eigen::Matrix<double, 3, 27> Bm;
-    // lazyProduct: these small fixed-size products (3×9·9×9, 27×3·3×27) are 2-3x faster coefficient-wise
-    // than through Eigen's blocked GEMM path, which it picks when rows + cols + depth > 20.
+  for (int g = 0; g < 9; ++g) {
+    const GaussPoint& gp = gp_[static_cast<size_t>(g)];
     for (int c = 0; c < 3; ++c) {
-      const Mat39 tH1 = t1.lazyProduct(gp.Hm[c]);
-      if (need0) {
-        const Mat39 tHb = b1 * tH1 + b0 * t0.lazyProduct(gp.Hm[c]);
-        Bm.row(c) = gp.Lm.row(c) + Eigen::Map<const Row27>(tHb.data());
-      } else {
-        Bm.row(c) = gp.Lm.row(c) + b1 * Eigen::Map<const Row27>(tH1.data());
-      }
+      // lazyProduct: a small fixed-size product (3×9·9×9) is 2-3x faster coefficient-wise than through
+      // Eigen's blocked GEMM path, which it picks when rows + cols + depth > 20.
+      const Mat39 tH = tb.lazyProduct(gp.Hm[static_cast<size_t>(c)]);
+      Ball.row(3 * g + c) = gp.Lm.row(c) + Eigen::Map<const Row27>(tH.data());
     }
-    const Eigen::Vector3d N = hD1 * (c1 * e1 + c0 * e0);  // N* = h D1 ε*_m (§6.3)
+    const Eigen::Vector3d e1 = e1all.segment<3>(3 * g), e0 = e0all.segment<3>(3 * g);
     U += membrane_energy(gp.dA, e1, hD1);
-    fm.noalias() += gp.dA * Bm.transpose() * N;
-    if (kL) {
-      const Eigen::Matrix<double, 3, 27> DB = (gp.dA * hD1) * Bm;
-      km.noalias() += Bm.transpose().lazyProduct(DB);
-      Hs += gp.dA * (N(0) * gp.Hm[0] + N(1) * gp.Hm[1] + N(2) * gp.Hm[2]);  // Σ_c N_c H_m,c
-    }
+    sN.segment<3>(3 * g) = gp.dA * (hD1 * (c1 * e1 + c0 * e0));
+    if (kL) DBall.middleRows<3>(3 * g) = (gp.dA * hD1) * Ball.middleRows<3>(3 * g);
   }
-  if (fL)
+  if (fL) {
+    const Eigen::Matrix<double, 27, 1> fm = Ball.transpose() * sN;  // Σ_gp dA B_mᵀ N*
     for (int i = 0; i < 9; ++i) fL->segment<3>(5 * i) += fm.segment<3>(3 * i);
-  if (kL)
-    for (int i = 0; i < 9; ++i)
-      for (int j = 0; j < 9; ++j) {
+  }
+  if (kL) {
+    // Σ_gp dA B_mᵀ h D1 B_m as one 27×27·27×27 product, and Σ_gp,c dA N_c H_m,c from the packed H columns.
+    const Eigen::Matrix<double, 27, 27> km = Ball.transpose() * DBall;
+    const Eigen::Matrix<double, 45, 1> hs = Hp_ * sN;
+    for (int j = 0; j < 9; ++j)
+      for (int i = 0; i < 9; ++i) {
         kL->block<3, 3>(5 * i, 5 * j) += km.block<3, 3>(3 * i, 3 * j);
-        kL->block<3, 3>(5 * i, 5 * j).diagonal().array() += Hs(i, j);
+        kL->block<3, 3>(5 * i, 5 * j).diagonal().array() += hs(i <= j ? i + j * (j + 1) / 2 : j + i * (i + 1) / 2);
       }
+  }
   return U;
 }
 
