@@ -163,6 +163,7 @@ class CholmodSolver final : public LinearSolver {
     check_values(A, "cholmod");
     factorized_ = false;
     sp_.clear();
+    dp_.clear();
     const auto t0 = Clock::now();
     cholmod_sparse S = header(A);
     single_threaded([&] { cholmod_l_factorize(&S, L_, &cc_); });
@@ -194,13 +195,12 @@ class CholmodSolver final : public LinearSolver {
     }
     factorized_ = true;
     ++stats_.factorizations;
-    if (single_) copy_to_single();
+    copy_factor();
   }
 
   bool set_single_precision_solves(bool on) override {
     single_ = on;
-    if (!on) sp_.clear();
-    else if (factorized_) copy_to_single();
+    if (factorized_) copy_factor();
     return true;
   }
 
@@ -223,6 +223,12 @@ class CholmodSolver final : public LinearSolver {
       sp_.solve(b, x);
       ++stats_.solves;
       ++stats_.single_solves;
+      stats_.solve_s += seconds_since(t0);
+      return;
+    }
+    if (!dp_.empty()) {  // the same solves on an exact copy (no per-supernode BLAS calls)
+      dp_.solve(b, x);
+      ++stats_.solves;
       stats_.solve_s += seconds_since(t0);
       return;
     }
@@ -270,10 +276,13 @@ class CholmodSolver final : public LinearSolver {
     if (L_) cholmod_l_free_factor(&L_, &cc_);
     factorized_ = false;
     sp_.clear();
+    dp_.clear();
   }
-  // Only a supernodal LLᵀ factor is copied; a simplicial LDLᵀ one (the indefinite fallback) keeps double solves.
-  void copy_to_single() {
+  // Only a supernodal LLᵀ factor is copied, in float (single_) or exactly; a simplicial LDLᵀ one (the indefinite
+  // fallback) keeps CHOLMOD's solves.
+  void copy_factor() {
     sp_.clear();
+    dp_.clear();
     if (!factorized_ || !L_->is_super || !L_->is_ll) return;
     SinglePrecisionFactor::Arrays a;
     a.n = static_cast<Index>(L_->n);
@@ -284,7 +293,8 @@ class CholmodSolver final : public LinearSolver {
     a.s = static_cast<const Index*>(L_->s);
     a.x = static_cast<const double*>(L_->x);
     a.perm = static_cast<const Index*>(L_->Perm);
-    sp_.assign(a);  // false (sp_ stays empty, double solves) if the factor does not fit in float
+    if (single_ && sp_.assign(a)) return;  // false (sp_ stays empty): the factor does not fit in float
+    dp_.assign(a);
   }
 
   mutable cholmod_common cc_{};
@@ -295,6 +305,7 @@ class CholmodSolver final : public LinearSolver {
   bool factorized_ = false;
   bool single_ = false;
   SinglePrecisionFactor sp_;  // non-empty: solves use it
+  DoublePrecisionFactor dp_;  // non-empty (and sp_ empty): solves use it
 };
 
 // ------------------------------------------------------------------------------------------------

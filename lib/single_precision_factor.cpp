@@ -1,4 +1,4 @@
-// Triangular solves with a float copy of a supernodal factor: lib/single_precision_factor.hpp.
+// Triangular solves with a float (or double) copy of a supernodal factor: lib/single_precision_factor.hpp.
 #include "lib/single_precision_factor.hpp"
 
 #include <algorithm>
@@ -8,7 +8,8 @@
 
 namespace shelldyn {
 
-void SinglePrecisionFactor::clear() {
+template <typename Real>
+void SupernodalFactorCopy<Real>::clear() {
   n_ = 0;
   blocks_.clear();
   rows_.clear();
@@ -16,7 +17,8 @@ void SinglePrecisionFactor::clear() {
   values_.clear();
 }
 
-bool SinglePrecisionFactor::assign(const Arrays& a) {
+template <typename Real>
+bool SupernodalFactorCopy<Real>::assign(const Arrays& a) {
   clear();
   if (a.n <= 0 || a.nsuper <= 0 || !a.super || !a.pi || !a.px || !a.s || !a.x)
     throw std::invalid_argument("SinglePrecisionFactor: empty or incomplete supernodal factor");
@@ -41,7 +43,7 @@ bool SinglePrecisionFactor::assign(const Arrays& a) {
         return false;
       }
     for (Index j = 0; j < ncol; ++j)
-      if (values_[static_cast<size_t>(b.vals + j * nrow + j)] == 0.0f) {
+      if (values_[static_cast<size_t>(b.vals + j * nrow + j)] == Real(0)) {
         clear();
         return false;
       }
@@ -58,7 +60,8 @@ bool SinglePrecisionFactor::assign(const Arrays& a) {
 namespace {
 // Σ a_i w_i with four partial sums in a fixed pattern (i mod 4), combined as (s0 + s1) + (s2 + s3): the same
 // value whatever the compiler vectorizes, and no serial chain of additions.
-inline double dot4(const float* a, const double* w, Index n) {
+template <typename Real>
+inline double dot4(const Real* a, const double* w, Index n) {
   double s0 = 0.0, s1 = 0.0, s2 = 0.0, s3 = 0.0;
   Index i = 0;
   for (; i + 4 <= n; i += 4) {
@@ -74,7 +77,8 @@ inline double dot4(const float* a, const double* w, Index n) {
 }
 }  // namespace
 
-void SinglePrecisionFactor::solve(const double* b, double* x) const {
+template <typename Real>
+void SupernodalFactorCopy<Real>::solve(const double* b, double* x) const {
   double* y = y_.data();
   double* w = w_.data();
   if (perm_.empty())
@@ -90,12 +94,23 @@ void SinglePrecisionFactor::solve(const double* b, double* x) const {
     for (Index i = 0, below = bl.nrow - bl.ncol; i < below; ++i) w[bl.ncol + i] = y[rows[i]];
   };
 
-  // Forward, L y = P b, blocks in column order; column j: divide by the pivot, then one axpy over the rows below,
-  // so every entry receives its updates in column order.
+  // Forward, L y = P b, blocks in column order; columns in pairs: divide by the pivots, then one pass over the rows
+  // below that subtracts both columns' updates (half the loads and stores of w), so every entry receives its updates
+  // in column order, a pair at a time. (Pairing the backward dot products as well measured slower.)
   for (const Block& bl : blocks_) {
     gather(bl);
-    const float* col = values_.data() + bl.vals;
-    for (Index j = 0; j < bl.ncol; ++j, col += bl.nrow) {
+    const Real* col = values_.data() + bl.vals;
+    Index j = 0;
+    for (; j + 1 < bl.ncol; j += 2, col += 2 * bl.nrow) {  // two columns per pass over the rows below
+      const Real* col1 = col + bl.nrow;
+      const double wj = w[j] / static_cast<double>(col[j]);
+      w[j] = wj;
+      const double wj1 = (w[j + 1] - static_cast<double>(col[j + 1]) * wj) / static_cast<double>(col1[j + 1]);
+      w[j + 1] = wj1;
+      for (Index i = j + 2; i < bl.nrow; ++i)
+        w[i] -= static_cast<double>(col[i]) * wj + static_cast<double>(col1[i]) * wj1;
+    }
+    if (j < bl.ncol) {
       const double wj = w[j] / static_cast<double>(col[j]);
       w[j] = wj;
       for (Index i = j + 1; i < bl.nrow; ++i) w[i] -= static_cast<double>(col[i]) * wj;
@@ -110,7 +125,7 @@ void SinglePrecisionFactor::solve(const double* b, double* x) const {
     const Block& bl = *it;
     gather(bl);
     for (Index j = bl.ncol - 1; j >= 0; --j) {
-      const float* col = values_.data() + bl.vals + j * bl.nrow;
+      const Real* col = values_.data() + bl.vals + j * bl.nrow;
       w[j] = (w[j] - dot4(col + j + 1, w + j + 1, bl.nrow - j - 1)) / static_cast<double>(col[j]);
     }
     std::copy(w, w + bl.ncol, y + bl.col0);
@@ -121,5 +136,8 @@ void SinglePrecisionFactor::solve(const double* b, double* x) const {
   else
     for (Index k = 0; k < n_; ++k) x[perm_[k]] = y[k];
 }
+
+template class SupernodalFactorCopy<float>;
+template class SupernodalFactorCopy<double>;
 
 }  // namespace shelldyn

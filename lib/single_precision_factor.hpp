@@ -25,21 +25,27 @@
 
 namespace shelldyn {
 
-class SinglePrecisionFactor {
- public:
-  struct Arrays {  // views of a supernodal LLᵀ factor (CHOLMOD's names)
-    Index n = 0, nsuper = 0;
-    const Index* super = nullptr;  // nsuper + 1 column starts
-    const Index* pi = nullptr;     // nsuper + 1 starts in s
-    const Index* px = nullptr;     // nsuper + 1 starts in x
-    const Index* s = nullptr;      // row indices
-    const double* x = nullptr;     // values
-    const Index* perm = nullptr;   // fill-reducing permutation (row k of L is row perm[k] of A); null: identity
-  };
+struct SupernodalArrays {  // views of a supernodal LLᵀ factor (CHOLMOD's names)
+  Index n = 0, nsuper = 0;
+  const Index* super = nullptr;  // nsuper + 1 column starts
+  const Index* pi = nullptr;     // nsuper + 1 starts in s
+  const Index* px = nullptr;     // nsuper + 1 starts in x
+  const Index* s = nullptr;      // row indices
+  const double* x = nullptr;     // values
+  const Index* perm = nullptr;   // fill-reducing permutation (row k of L is row perm[k] of A); null: identity
+};
 
-  // Copies the structure and rounds the values to float. Returns false (and stays empty) if a value does not fit:
-  // beyond float's range (~3.4e38) or a pivot that rounds to zero; the caller then keeps double solves. Throws
-  // std::invalid_argument on inconsistent arrays.
+// Real = float: the single-precision copy described above. Real = double: the same solves on an exact copy of the
+// factor, used for solve_precision = double (docs/dependencies.md §5.5): on a small factor (the flying plate's,
+// 735 unknowns) CHOLMOD's supernodal solve spends much of its time in per-supernode BLAS calls.
+template <typename Real>
+class SupernodalFactorCopy {
+ public:
+  using Arrays = SupernodalArrays;
+
+  // Copies the structure and the values (rounded to Real). Returns false (and stays empty) if a value does not fit:
+  // beyond Real's range (float: ~3.4e38), not finite, or a pivot that rounds to zero; the caller then keeps
+  // CHOLMOD's own solves. Throws std::invalid_argument on inconsistent arrays.
   bool assign(const Arrays& a);
   bool empty() const { return n_ == 0; }
   void clear();
@@ -55,8 +61,14 @@ class SinglePrecisionFactor {
   Index n_ = 0;
   std::vector<Block> blocks_;
   std::vector<Index> rows_, perm_;
-  std::vector<float> values_;
+  std::vector<Real> values_;
   mutable std::vector<double> y_, w_;  // permuted right-hand side; one block's rows gathered
 };
+
+using SinglePrecisionFactor = SupernodalFactorCopy<float>;
+using DoublePrecisionFactor = SupernodalFactorCopy<double>;
+
+extern template class SupernodalFactorCopy<float>;
+extern template class SupernodalFactorCopy<double>;
 
 }  // namespace shelldyn
