@@ -232,6 +232,8 @@ CR9Shell::CR9Shell(const std::array<Eigen::Vector3d, 9>& X0, const std::array<Ei
     }
   for (int j = 0; j < 45; ++j)
     for (int i = 0; i <= j; ++i) Kbsp_(i + j * (j + 1) / 2) = Kbs_(i, j);
+  for (int j = 0; j < 27; ++j)
+    if ((Lall_.col(j).array() != 0.0).any()) lcols_.push_back(j);
   std::vector<int> active;
   for (int i = 0; i < 45; ++i)
     if ((Kbs_.row(i).array() != 0.0).any()) active.push_back(i);
@@ -303,7 +305,10 @@ Eigen::Matrix<double, 27, 1> CR9Shell::membrane_strains(const Mat39& t) const {
     g(j + j * (j + 1) / 2) = t.col(j).squaredNorm();
   }
   const Eigen::Map<const Eigen::Matrix<double, 27, 1>> v(t.data());
-  Eigen::Matrix<double, 27, 1> e = Lall_.lazyProduct(v);
+  // L·t column by column (fixed-size axpys), over the columns of L that are not zero: a flat element's linear
+  // membrane strains do not involve the normal translations t_z, a third of the columns.
+  Eigen::Matrix<double, 27, 1> e = Eigen::Matrix<double, 27, 1>::Zero();
+  for (const int j : lcols_) e.noalias() += Lall_.col(j) * v(j);
   e.noalias() += 0.5 * Hp_.transpose().lazyProduct(g);
   return e;
 }
@@ -368,8 +373,10 @@ double CR9Shell::membrane_force(const Mat39& t1, const Mat39& t0, double c1, dou
     sN.segment<3>(3 * g) = dA * N;
   }
   // Σ_gp dA B_mᵀ N with B_m,c = L_m,c + (t̄ H_c) rows, t̄ = b1 t1 + b0 t0: Lᵀ s + t̄ Σ_gp,c s_gp,c H_c.
-  Eigen::Matrix<double, 27, 1> fm = Lall_.transpose().lazyProduct(sN);
-  const Eigen::Matrix<double, 45, 1> hs = Hp_.lazyProduct(sN);
+  Eigen::Matrix<double, 27, 1> fm = Eigen::Matrix<double, 27, 1>::Zero();
+  for (const int j : lcols_) fm(j) = Lall_.col(j).dot(sN);
+  Eigen::Matrix<double, 45, 1> hs = Hp_.col(0) * sN(0);
+  for (int k = 1; k < 27; ++k) hs.noalias() += Hp_.col(k) * sN(k);
   Mat9 Hs;
   for (int j = 0; j < 9; ++j)
     for (int i = 0; i <= j; ++i) Hs(i, j) = Hs(j, i) = hs(i + j * (j + 1) / 2);

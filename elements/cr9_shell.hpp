@@ -148,6 +148,7 @@ class CR9Shell {
   // The data of membrane_force() and of K_bs w in the compact form a residual streams through (per element
   // and residual ~24 kB instead of ~40 kB; a residual of a large mesh reads it from memory, not the cache):
   Eigen::Matrix<double, 27, 27> Lall_;  // row 3g + c = gp_[g].Lm.row(c)
+  std::vector<int> lcols_;              // the columns of Lall_ with a nonzero entry (18 of 27 for a flat element)
   Eigen::Matrix<double, 45, 27> Hp_;    // column 3g + c = upper triangle of gp_[g].Hm[c], packed (k = i + j(j+1)/2)
   Eigen::Matrix<double, 27, 1> dAall_;  // entry 3g + c = gp_[g].dA
   Eigen::Matrix<double, 1035, 1> Kbsp_; // upper triangle of Kbs_, packed by columns (k = i + j(j+1)/2)
