@@ -154,7 +154,7 @@ class CR9Shell {
   Eigen::Matrix<double, 1035, 1> Kbsp_; // upper triangle of Kbs_, packed by columns (k = i + j(j+1)/2)
   // A flat element's K_bs is exactly zero on its in-plane translations (the curvatures and transverse shears
   // of §4.3 do not involve them): K_bs w then runs on the DOFs with a nonzero row only, as a dense block
-  // (27 × 27 instead of the packed 45 × 45; ~4× fewer operations). Empty when every row is nonzero.
+  // (27 × 27 instead of the packed 45 × 45: 729 multiplications instead of 2 025). Empty when every row is nonzero.
   std::vector<int> kbs_active_;
   Eigen::MatrixXd kbs_block_;
   Vec45 kbs_times(const Vec45& w) const;  // Kbs_ w from Kbsp_ or kbs_block_
