@@ -9,7 +9,9 @@
 // "klu" factors the full storage and also works for non-symmetric matrices (e.g. ida-bdf's Schur complement
 // with jacobian=fd-inertia, or unsymmetric load tangents in statics).
 //   - "cholmod":    CHOLMOD (cholmod_l_*), upper triangle (stype = +1), AMD ordering, supernodal LLᵀ.
-//                   Optionally solves with a float copy of the factor (set_single_precision_solves below).
+//                   The triangular solves of a supernodal factor run shelldyn's own kernels on a copy of it
+//                   (lib/single_precision_factor.hpp): an exact one, or a float one with
+//                   set_single_precision_solves below (docs/dependencies.md §5.5).
 //                   If the matrix is not positive definite (CHOLMOD_NOT_POSDEF), the solver switches
 //                   PERMANENTLY to simplicial LDLᵀ (re-analysis once; visible as an extra count in
 //                   stats().analyses) and retries. Rationale: a tangent that was indefinite once
@@ -112,7 +114,8 @@ bool single_precision_setting(const std::string& value, const std::string& linea
 
 // The BLAS the sparse factorizations run on, for run.json: with OpenBLAS its build configuration and the kernel
 // set it chose for this CPU at load time, e.g. "OpenBLAS 0.3.21 NO_LAPACKE DYNAMIC_ARCH NO_AFFINITY Prescott
-// MAX_THREADS=64". The kernels set the summation order inside CHOLMOD's supernodal factorization and solves,
+// MAX_THREADS=64". The kernels set the summation order inside CHOLMOD's supernodal factorization (and in the
+// simplicial fallback's solves),
 // so two machines whose cores differ give results that differ at round-off (docs/dependencies.md §5.6).
 // "unknown (not OpenBLAS)" when the loaded BLAS is another one.
 std::string blas_description();
