@@ -114,8 +114,7 @@ bool single_precision_setting(const std::string& value, const std::string& linea
 
 // The BLAS the sparse factorizations run on, for run.json: with OpenBLAS its build configuration and the kernel
 // set it chose for this CPU at load time, e.g. "OpenBLAS 0.3.21 NO_LAPACKE DYNAMIC_ARCH NO_AFFINITY Prescott
-// MAX_THREADS=64". The kernels set the summation order inside CHOLMOD's supernodal factorization (and in the
-// simplicial fallback's solves),
+// MAX_THREADS=64". The kernels set the summation order inside CHOLMOD's supernodal factorization,
 // so two machines whose cores differ give results that differ at round-off (docs/dependencies.md §5.6).
 // "unknown (not OpenBLAS)" when the loaded BLAS is another one.
 std::string blas_description();
