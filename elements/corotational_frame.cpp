@@ -25,6 +25,13 @@ Eigen::Matrix3d unit_jacobian(const Eigen::Vector3d& v) {
   return (Eigen::Matrix3d::Identity() - h * h.transpose()) / n;
 }
 
+// P(v) w without forming P(v): (w − v̂ (v̂·w)) / |v|.
+Eigen::Vector3d unit_jacobian_times(const Eigen::Vector3d& v, const Eigen::Vector3d& w) {
+  const double n = v.norm();
+  const Eigen::Vector3d h = v / n;
+  return (w - h.dot(w) * h) / n;
+}
+
 // H(v; u): Hessian of u·v̂ with respect to v (§3.4 group 1).
 Eigen::Matrix3d unit_hessian(const Eigen::Vector3d& v, const Eigen::Vector3d& u) {
   const double n = v.norm();
@@ -193,6 +200,17 @@ CorotationalFrame::Vec45 CorotationalFrame::local_variables(const std::array<Eig
   return u;
 }
 
+CorotationalFrame::Weights CorotationalFrame::weights(const Vec45& fL) const {
+  Eigen::Vector3d wx = Eigen::Vector3d::Zero(), wy = Eigen::Vector3d::Zero(), wz = Eigen::Vector3d::Zero();
+  for (int i = 0; i < 9; ++i) {
+    wx += fL(5 * i) * rel_[i] + fL(5 * i + 3) * p_[i];
+    wy += fL(5 * i + 1) * rel_[i] + fL(5 * i + 4) * p_[i];
+    wz += fL(5 * i + 2) * rel_[i];
+  }
+  const Eigen::Vector3d ex = R_.col(0), ey = R_.col(1);
+  return {wz, wx + ey.cross(wz), wy + wz.cross(ex)};
+}
+
 CorotationalFrame::Vec45 CorotationalFrame::apply_transpose(const Vec45& fL) const {
   if (!director_derivatives_)
     throw std::logic_error("CorotationalFrame: apply_transpose() of a frame built for local_variables() only (no A1)");
@@ -203,27 +221,18 @@ CorotationalFrame::Vec45 CorotationalFrame::apply_transpose(const Vec45& fL) con
   // and E_y,k = ∓P_c P_a, ∓P_c P_b (§3.3) and symmetric P's, the four corners need P_s ŵ_x, P_c ŵ_y and one
   // application of P_a and of P_b: ~300 multiplications instead of building the 45 × 12 block C.
   const Eigen::Vector3d ex = R_.col(0), ey = R_.col(1);
-  Eigen::Vector3d wx = Eigen::Vector3d::Zero(), wy = Eigen::Vector3d::Zero(), wz = Eigen::Vector3d::Zero();
   Eigen::Vector3d fsum = Eigen::Vector3d::Zero();
   Vec45 F;
   for (int i = 0; i < 9; ++i) {
     const Eigen::Vector3d ft = fL.segment<3>(5 * i);
-    const double fx = fL(5 * i + 3), fy = fL(5 * i + 4);
-    wx += ft(0) * rel_[i] + fx * p_[i];
-    wy += ft(1) * rel_[i] + fy * p_[i];
-    wz += ft(2) * rel_[i];
     fsum += ft;
-    F.segment<3>(5 * i) = R_ * ft;                                      // D: R^T block, transposed
-    F.segment<2>(5 * i + 3) = A1_[i].transpose() * (fx * ex + fy * ey);  // D: ([e_x e_y]^T A1_i)^T
+    F.segment<3>(5 * i) = R_ * ft;                                                             // D: R^T block, transposed
+    F.segment<2>(5 * i + 3) = A1_[i].transpose() * (fL(5 * i + 3) * ex + fL(5 * i + 4) * ey);  // D: ([e_x e_y]^T A1_i)^T
   }
-  // P(v) w = (w - v̂ (v̂·w)) / |v| (unit_jacobian applied to a vector).
-  const auto P = [](const Eigen::Vector3d& v, const Eigen::Vector3d& w) -> Eigen::Vector3d {
-    const double n = v.norm();
-    const Eigen::Vector3d h = v / n;
-    return (w - h.dot(w) * h) / n;
-  };
-  const Eigen::Vector3d gx = P(s_, wx + ey.cross(wz)), gy = P(c_, wy + wz.cross(ex));
-  const Eigen::Vector3d fa = P(a_, gx + gy), fb = P(b_, gx - gy), f0 = -0.25 * (R_ * fsum);
+  const Weights w = weights(fL);
+  const Eigen::Vector3d gx = unit_jacobian_times(s_, w.xh), gy = unit_jacobian_times(c_, w.yh);
+  const Eigen::Vector3d fa = unit_jacobian_times(a_, gx + gy), fb = unit_jacobian_times(b_, gx - gy);
+  const Eigen::Vector3d f0 = -0.25 * (R_ * fsum);
   F.segment<3>(0) += f0 - fa;
   F.segment<3>(5) += f0 + fb;
   F.segment<3>(10) += f0 + fa;
@@ -273,17 +282,12 @@ void CorotationalFrame::tangent(const Mat45& kL, const Vec45& fL, bool geometric
 
 void CorotationalFrame::add_geometric_stiffness(const Vec45& fL, Mat45* K) const {
   derivatives();
-  // K_σ = Σ_j (f_L)_j ∂²(u_L)_j/∂u_G∂u_G, §3.4. Weight vectors:
-  Eigen::Vector3d wx = Eigen::Vector3d::Zero(), wy = Eigen::Vector3d::Zero(), wz = Eigen::Vector3d::Zero();
-  for (int i = 0; i < 9; ++i) {
-    wx += fL(5 * i) * rel_[i] + fL(5 * i + 3) * p_[i];
-    wy += fL(5 * i + 1) * rel_[i] + fL(5 * i + 4) * p_[i];
-    wz += fL(5 * i + 2) * rel_[i];
-  }
+  // K_σ = Σ_j (f_L)_j ∂²(u_L)_j/∂u_G∂u_G, §3.4, through the weight vectors.
+  const Weights w = weights(fL);
+  const Eigen::Vector3d &wz = w.z, &wxh = w.xh, &wyh = w.yh;
   const Eigen::Vector3d ex = R_.col(0), ey = R_.col(1);
 
   // Group 1: corner-corner, from the second derivatives of e_x, e_y, e_z = e_x × e_y.
-  const Eigen::Vector3d wxh = wx + ey.cross(wz), wyh = wy + wz.cross(ex);
   Mat312 Ga = Mat312::Zero(), Gb = Mat312::Zero();
   Ga.block<3, 3>(0, 0) = -Eigen::Matrix3d::Identity();
   Ga.block<3, 3>(0, 6) = Eigen::Matrix3d::Identity();

@@ -78,6 +78,13 @@ class CorotationalFrame {
     if (!have_corner_columns_) compute_corner_columns();
   }
   void compute_corner_columns() const;
+  // The weight vectors of f_L (§3.4) that Tᵀf_L's corner part and K_σ contract with the triad's derivatives:
+  // w_z = Σ_i f_t,i,z (x_i − x_O), and w_x, w_y (w_x = Σ_i f_t,i,x (x_i − x_O) + f_θ,i,x p_i) with e_z = e_x × e_y
+  // folded in: ŵ_x = w_x + e_y × w_z, ŵ_y = w_y + w_z × e_x.
+  struct Weights {
+    Eigen::Vector3d z, xh, yh;
+  };
+  Weights weights(const Vec45& fL) const;
 
   std::array<Eigen::Vector3d, 9> rel_;  // x_i - x_O
   std::array<Eigen::Vector3d, 9> p_;

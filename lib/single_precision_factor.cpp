@@ -21,18 +21,18 @@ template <typename Real>
 bool SupernodalFactorCopy<Real>::assign(const Arrays& a) {
   clear();
   if (a.n <= 0 || a.nsuper <= 0 || !a.super || !a.pi || !a.px || !a.s || !a.x)
-    throw std::invalid_argument("SinglePrecisionFactor: empty or incomplete supernodal factor");
+    throw std::invalid_argument("SupernodalFactorCopy: empty or incomplete supernodal factor");
   if (a.super[0] != 0 || a.super[a.nsuper] != a.n)
-    throw std::invalid_argument("SinglePrecisionFactor: supernode columns do not cover 0.." + std::to_string(a.n - 1));
+    throw std::invalid_argument("SupernodalFactorCopy: supernode columns do not cover 0.." + std::to_string(a.n - 1));
   blocks_.reserve(static_cast<size_t>(a.nsuper));
   Index max_rows = 0;
   for (Index k = 0; k < a.nsuper; ++k) {
     const Index ncol = a.super[k + 1] - a.super[k], nrow = a.pi[k + 1] - a.pi[k];
     if (ncol <= 0 || nrow < ncol || a.px[k + 1] - a.px[k] < nrow * ncol)
-      throw std::invalid_argument("SinglePrecisionFactor: supernode " + std::to_string(k) + " has an inconsistent shape");
+      throw std::invalid_argument("SupernodalFactorCopy: supernode " + std::to_string(k) + " has an inconsistent shape");
     Block b{a.super[k], ncol, nrow, static_cast<Index>(rows_.size()), static_cast<Index>(values_.size())};
     for (Index p = a.pi[k] + ncol; p < a.pi[k + 1]; ++p) {
-      if (a.s[p] < 0 || a.s[p] >= a.n) throw std::invalid_argument("SinglePrecisionFactor: row index out of range");
+      if (a.s[p] < 0 || a.s[p] >= a.n) throw std::invalid_argument("SupernodalFactorCopy: row index out of range");
       rows_.push_back(a.s[p]);
     }
     // The block's ncol columns of nrow entries each (CHOLMOD may pad px; the padding is not copied).
