@@ -274,8 +274,9 @@ TEST(EmExact, DissipationIsNonPositiveAndAccountedFor) {
     EXPECT_LT(r.final_dH, -1e-3);             // and it does remove energy
     EXPECT_LT(r.max_balance, 1e-10);          // K + V + D is conserved exactly
     // Momenta stay exact: G is orthogonal to the rigid modes. Measured 7.6e-14 / 7.3e-14 (ΔL) and 1.6e-14 /
-    // 1.3e-14 (ΔJ) with ξ G Δu applied as a chain of products; forming G first and multiplying gave
-    // 4.8e-13–1.04e-12 and 1.7e-13–1.9e-13 (its rounding scales with |G| |Δu|, Δu mostly rigid), which fails here.
+    // 1.3e-14 (ΔJ) with ξ G Δu applied as a chain of products. Forming G first and multiplying (its rounding
+    // scales with |G| |Δu|, Δu mostly rigid) gave 3.1e-13 / 8.9e-13 and 3.0e-13 / 1.5e-13 with the element
+    // kernels of 5b34afd (4.8e-13 / 1.04e-12 and 1.7e-13 / 1.9e-13 before them): each case fails a bound.
     EXPECT_LT(r.max_dL, 4e-13);
     EXPECT_LT(r.max_dJ, 1e-13);
   }
