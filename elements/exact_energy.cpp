@@ -8,22 +8,75 @@
 
 namespace shelldyn {
 
-RigidRows midpoint_rigid_rows(const NodeVectors& x_mid, const NodeVectors& p_mid,
-                              const std::array<DirectorChart, 9>& charts) {
+MidpointRigidRows::MidpointRigidRows(const NodeVectors& x_mid, const NodeVectors& p_mid,
+                                     const std::array<DirectorChart, 9>& charts)
+    : p_(p_mid), charts_(charts) {
   // Rotations about the midpoint centroid c instead of the origin: the same row space (a rotation about
   // the origin is one about c plus a translation), but RRᵀ stays well conditioned far from the origin.
   Eigen::Vector3d c = Eigen::Vector3d::Zero();
   for (const auto& x : x_mid) c += x;
   c /= 9.0;
-  RigidRows R = RigidRows::Zero();
+  Eigen::Vector3d s = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d J = Eigen::Matrix3d::Zero();
   for (int i = 0; i < 9; ++i) {
     const Eigen::Vector3d r = x_mid[i] - c;
-    const DirectorChart& ch = charts[i];
+    r_[i] = r;
+    s += r;
+    // d-slots of the rotation rows: (e_j × r)·(e_k × r) = δ_jk |r|² − r_j r_k.
+    J.noalias() -= r * r.transpose();
+    J.diagonal().array() += r.squaredNorm();
+    // q-slots: the n and m components of u_j = e_j × p, i.e. u_j·u_k − u_j[l] u_k[l] (u_j·u_k = δ_jk|p|² − p_j p_k).
+    const Eigen::Vector3d& p = p_mid[i];
+    const int l = charts[i].l;
+    Eigen::Vector3d ul;  // u_j[l] = (e_j × p)[l]
+    for (int j = 0; j < 3; ++j) ul[j] = Eigen::Vector3d::Unit(j).cross(p)[l];
+    J.noalias() -= p * p.transpose() + ul * ul.transpose();
+    J.diagonal().array() += p.squaredNorm();
+  }
+  gram_.setZero();
+  gram_.topLeftCorner<3, 3>().diagonal().setConstant(9.0);
+  // Translation × rotation: Σ_i e_j·(e_k × r_i) = (e_k × s)_j, zero up to the rounding of c.
+  Eigen::Matrix3d B;
+  for (int k = 0; k < 3; ++k) B.col(k) = Eigen::Vector3d::Unit(k).cross(s);
+  gram_.topRightCorner<3, 3>() = B;
+  gram_.bottomLeftCorner<3, 3>() = B.transpose();
+  gram_.bottomRightCorner<3, 3>() = J;
+}
+
+MidpointRigidRows::Vec6 MidpointRigidRows::times(const Vec45E& f) const {
+  Eigen::Vector3d res = Eigen::Vector3d::Zero(), mom = Eigen::Vector3d::Zero();
+  for (int i = 0; i < 9; ++i) {
+    const Eigen::Vector3d fd = f.segment<3>(5 * i);
+    Eigen::Vector3d g = Eigen::Vector3d::Zero();  // S_iᵀ f_q,i
+    g[charts_[i].n] = f[5 * i + 3];
+    g[charts_[i].m] = f[5 * i + 4];
+    res += fd;
+    mom += r_[i].cross(fd) + p_[i].cross(g);
+  }
+  Vec6 y;
+  y << res, mom;
+  return y;
+}
+
+void MidpointRigidRows::subtract_transpose_times(const Vec6& a, Vec45E& y) const {
+  const Eigen::Vector3d at = a.head<3>(), ar = a.tail<3>();
+  for (int i = 0; i < 9; ++i) {
+    y.segment<3>(5 * i) -= at + ar.cross(r_[i]);
+    const Eigen::Vector3d q = ar.cross(p_[i]);
+    y[5 * i + 3] -= q[charts_[i].n];
+    y[5 * i + 4] -= q[charts_[i].m];
+  }
+}
+
+RigidRows MidpointRigidRows::dense() const {
+  RigidRows R = RigidRows::Zero();
+  for (int i = 0; i < 9; ++i) {
+    const DirectorChart& ch = charts_[i];
     for (int k = 0; k < 3; ++k) {
       const Eigen::Vector3d ek = Eigen::Vector3d::Unit(k);
       R(k, 5 * i + k) = 1.0;                                        // translation t_k
-      R.block<1, 3>(3 + k, 5 * i) = ek.cross(r).transpose();        // rotation r_k: d-slots e_k × (x − c)
-      const Eigen::Vector3d ep = ek.cross(p_mid[i]);                //               q-slots S_i (e_k × p)
+      R.block<1, 3>(3 + k, 5 * i) = ek.cross(r_[i]).transpose();    // rotation r_k: d-slots e_k × (x − c)
+      const Eigen::Vector3d ep = ek.cross(p_[i]);                   //               q-slots S_i (e_k × p)
       R(3 + k, 5 * i + 3) = ep[ch.n];
       R(3 + k, 5 * i + 4) = ep[ch.m];
     }
@@ -31,13 +84,25 @@ RigidRows midpoint_rigid_rows(const NodeVectors& x_mid, const NodeVectors& p_mid
   return R;
 }
 
-CorrectionInfo energy_momentum_correction(const RigidRows& R, const Vec45E& du, double dU, Vec45E& F, double guard) {
-  const Eigen::LLT<Eigen::Matrix<double, 6, 6>> RRt(R * R.transpose());
+RigidRows midpoint_rigid_rows(const NodeVectors& x_mid, const NodeVectors& p_mid,
+                              const std::array<DirectorChart, 9>& charts) {
+  return MidpointRigidRows(x_mid, p_mid, charts).dense();
+}
+
+CorrectionInfo energy_momentum_correction(const MidpointRigidRows& R, const Vec45E& du, double dU, Vec45E& F,
+                                          double guard) {
+  const Eigen::LLT<Eigen::Matrix<double, 6, 6>> RRt(R.gram());
   if (RRt.info() != Eigen::Success) throw std::domain_error("energy_momentum_correction: singular rigid rows");
+  // Both right-hand sides in one solve: (RRᵀ)⁻¹ [R F, R Δu].
+  Eigen::Matrix<double, 6, 2> rhs;
+  rhs.col(0) = R.times(F);
+  rhs.col(1) = R.times(du);
+  const Eigen::Matrix<double, 6, 2> sol = RRt.solve(rhs);
   // a = −(RRᵀ)⁻¹ R F: removes the resultant and the midpoint moment of F.
-  F.noalias() -= R.transpose() * RRt.solve(R * F);
+  R.subtract_transpose_times(sol.col(0), F);
   // z = Δu with its midpoint-rigid part removed (R z = 0, Δuᵀ z = zᵀ z).
-  const Vec45E z = du - R.transpose() * RRt.solve(R * du);
+  Vec45E z = du;
+  R.subtract_transpose_times(sol.col(1), z);
   CorrectionInfo info;
   info.z_norm2 = z.squaredNorm();
   if (info.z_norm2 <= guard * du.squaredNorm() || info.z_norm2 == 0.0) {

@@ -8,6 +8,7 @@
 #include <cstring>
 #include <exception>
 #include <mutex>
+#include <optional>
 
 #include <omp.h>
 #include <stdexcept>
@@ -475,7 +476,7 @@ double Model::exact_internal(const Eigen::VectorXd& u_n, const Eigen::VectorXd& 
     const double U1 = el.algorithmic_internal(states[static_cast<size_t>(e)], un, u1, ch, 0.5, 0.0, &fe, K ? &ke : nullptr);
     energy[static_cast<size_t>(e)] = U1;
     const CR9Shell::Vec45 du = u1 - un;
-    RigidRows R;
+    std::optional<MidpointRigidRows> R;
     if (correct || xi > 0.0) {
       NodeVectors xm, pm;
       const auto& nodes = mesh_.elements[static_cast<size_t>(e)];
@@ -486,18 +487,18 @@ double Model::exact_internal(const Eigen::VectorXd& u_n, const Eigen::VectorXd& 
                       : Vec3(0.5 * (shelldyn::director(un.segment<2>(k + 3), ch[a]) +
                                     shelldyn::director(u1.segment<2>(k + 3), ch[a])));
       }
-      R = midpoint_rigid_rows(xm, pm, ch);
+      R.emplace(xm, pm, ch);
     }
     if (correct) {  // theory §3: R F* = 0, Δuᵀ F* = ΔU
       const double fmax = fe.cwiseAbs().maxCoeff();
-      const CorrectionInfo ci = energy_momentum_correction(R, du, U1 - U_n[static_cast<size_t>(e)], fe);
+      const CorrectionInfo ci = energy_momentum_correction(*R, du, U1 - U_n[static_cast<size_t>(e)], fe);
       guard[static_cast<size_t>(e)] = ci.rigid_guard;
       if (fmax > 0.0) beta_z[static_cast<size_t>(e)] = std::abs(ci.beta) * std::sqrt(ci.z_norm2) / fmax;
     }
     if (xi > 0.0) {  // theory §6: ξ G Δu with G = Π Tᵀ k0 T Π (PSD, G Rᵀ = 0)
       const CR9Shell::Vec45 um = 0.5 * (un + u1);
       const CR9Shell::Mat45 T = el.frame(um, ch).matrix();
-      const CR9Shell::Mat45 P = rigid_complement_projector(R);
+      const CR9Shell::Mat45 P = rigid_complement_projector(R->dense());
       const CR9Shell::Mat45& k0e = (*k0)[static_cast<size_t>(e)];
       // G Δu as a chain of products, Pᵀ(Tᵀ(k0 (T (P Δu)))), not through the matrix G: Δu is mostly rigid
       // motion, which G annihilates, so (G)Δu would carry a rounding of ~1e-16 |G| |Δu| in every direction,

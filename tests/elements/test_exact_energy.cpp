@@ -67,7 +67,7 @@ Check check_pair(const CR9Shell& el, const Geometry& g, const Pair& p, bool corr
     xm[k] = 0.5 * (xn[k] + x1[k]);
     pm[k] = 0.5 * (pn[k] + p1[k]);
   }
-  const RigidRows R = midpoint_rigid_rows(xm, pm, p.ch);
+  const MidpointRigidRows R(xm, pm, p.ch);
   const Vec45 du = p.u1 - p.un;
   Vec45 Fs = F;
   CorrectionInfo info;
@@ -115,6 +115,48 @@ TEST(ExactEnergy, CorrectedForceHasZeroResultantMomentAndExactWork) {
   EXPECT_LT(worst_mom, 1e-13);
   EXPECT_LT(worst_work, 1e-13);
   EXPECT_GT(best_paper, 1e-8);  // the paper's force alone is not energy-consistent on these steps
+}
+
+// The structured products of MidpointRigidRows (R f, Rᵀa and RRᵀ from nodal vectors) against the dense
+// 6 × 45 rows, on midpoint configurations far from the origin (as on the flying plate, 70 m out) with every
+// dependent director component. A wrong sign or slot in any one of them is an O(1) difference.
+TEST(ExactEnergy, StructuredRigidRowsEqualTheDenseRows) {
+  double worst = 0.0;
+  for (Shape s : kShapes)
+    for (Facing f : kFacings) {
+      const Geometry g = make_geometry(s, f);
+      for (unsigned seed = 1; seed <= 3; ++seed) {
+        const Pair p = random_pair(g, 0.05, seed);
+        Nodes xn, pn, x1, p1;
+        configuration_from_dofs(g, p.un, p.ch, &xn, &pn);
+        configuration_from_dofs(g, p.u1, p.ch, &x1, &p1);
+        NodeVectors xm, pm;
+        const Eigen::Vector3d far(70.0, -40.0, 25.0);
+        for (int k = 0; k < 9; ++k) {
+          xm[k] = far + 0.5 * (xn[k] + x1[k]);
+          pm[k] = 0.5 * (pn[k] + p1[k]);
+        }
+        const MidpointRigidRows R(xm, pm, p.ch);
+        const RigidRows D = R.dense();
+        std::mt19937 rng(seed + 500);
+        std::uniform_real_distribution<double> U(-1.0, 1.0);
+        Vec45 v;
+        MidpointRigidRows::Vec6 a;
+        for (int k = 0; k < 45; ++k) v[k] = U(rng);
+        for (int k = 0; k < 6; ++k) a[k] = U(rng);
+        Vec45 y = v;
+        R.subtract_transpose_times(a, y);
+        const double e_times = (R.times(v) - D * v).norm() / (D.norm() * v.norm());
+        const double e_transpose = ((v - y) - D.transpose() * a).norm() / (D.norm() * a.norm());
+        const Eigen::Matrix<double, 6, 6> G = D * D.transpose();
+        const double e_gram = (R.gram() - G).norm() / G.norm();
+        worst = std::max({worst, e_times, e_transpose, e_gram});
+        EXPECT_LT(e_times, 1e-15) << g.name << " seed " << seed;
+        EXPECT_LT(e_transpose, 1e-15) << g.name << " seed " << seed;
+        EXPECT_LT(e_gram, 1e-15) << g.name << " seed " << seed;
+      }
+    }
+  std::printf("structured against dense rigid rows: max relative difference %.2e\n", worst);
 }
 
 TEST(ExactEnergy, WithoutTheCorrectionTheWorkIdentityFails) {
