@@ -407,17 +407,26 @@ int Model::rechart(State& s, double hysteresis) {
 
 // ---- em-exact (docs/theory/exact-energy-momentum.md) ------------------------------------------------------
 
-void Model::scalar_mass_times(const Eigen::VectorXd& x, Eigen::VectorXd& y) const {
+void Model::scalar_mass_times(const Eigen::VectorXd& x, const Eigen::VectorXd& y, Eigen::VectorXd& mx,
+                              Eigen::VectorXd& my) const {
   const Index n3 = 3 * static_cast<Index>(mesh_.num_nodes());
-  if (x.size() != n3) throw std::invalid_argument("Model::scalar_mass_times: x needs 3 entries per node");
-  y.setZero(n3);
+  if (x.size() != n3 || y.size() != n3)
+    throw std::invalid_argument("Model::scalar_mass_times: x and y need 3 entries per node");
+  mx.setZero(n3);
+  my.setZero(n3);
   for_each_element(assembler_, [&](int e) {  // colours: no two elements of a colour share a node
     const auto& nodes = mesh_.elements[static_cast<size_t>(e)];
-    const auto& m = elements_[static_cast<size_t>(e)].scalar_mass();
+    Eigen::Matrix<double, 9, 6> X;  // the element's nodal 3-vectors of x and y, one node per row
     for (size_t a = 0; a < 9; ++a) {
-      Vec3 s = Vec3::Zero();
-      for (size_t b = 0; b < 9; ++b) s += m(static_cast<Index>(a), static_cast<Index>(b)) * x.segment<3>(3 * static_cast<Index>(nodes[b]));
-      y.segment<3>(3 * static_cast<Index>(nodes[a])) += s;
+      const Index k = 3 * static_cast<Index>(nodes[a]);
+      X.block<1, 3>(static_cast<Index>(a), 0) = x.segment<3>(k).transpose();
+      X.block<1, 3>(static_cast<Index>(a), 3) = y.segment<3>(k).transpose();
+    }
+    const Eigen::Matrix<double, 9, 6> Y = elements_[static_cast<size_t>(e)].scalar_mass().lazyProduct(X);
+    for (size_t a = 0; a < 9; ++a) {
+      const Index k = 3 * static_cast<Index>(nodes[a]);
+      mx.segment<3>(k) += Y.block<1, 3>(static_cast<Index>(a), 0).transpose();
+      my.segment<3>(k) += Y.block<1, 3>(static_cast<Index>(a), 3).transpose();
     }
   });
 }

@@ -112,8 +112,10 @@ class Model final : public SemiDiscreteSystem {
   void add_damping_matrix(double c, SparseMatrix& J) const override;
 
   // ---- Embedded kinematics of the exactly conserving step em-exact (docs/theory/exact-energy-momentum.md) ----
-  // y = (m ⊗ I₃) x: x, y hold one 3-vector per node; m = Σ_e ∫ N_i N_j dA (consistent scalar mass).
-  void scalar_mass_times(const Eigen::VectorXd& x, Eigen::VectorXd& y) const;
+  // mx = (m ⊗ I₃) x and my = (m ⊗ I₃) y in one element pass: x, y, mx, my hold one 3-vector per node;
+  // m = Σ_e ∫ N_i N_j dA (consistent scalar mass).
+  void scalar_mass_times(const Eigen::VectorXd& x, const Eigen::VectorXd& y, Eigen::VectorXd& mx,
+                         Eigen::VectorXd& my) const;
   // Strain energy U_e(u_n) of every element at the start u_n of a step (U.size() = number of elements), from the
   // step's element states (CR9Shell::step_energy(): bitwise CR9Shell::internal()'s energy), so no frames or local
   // variables of its own when the step's states are needed anyway.

@@ -10,6 +10,7 @@
 #include "lib/model.hpp"
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -64,10 +65,20 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
     max_cuts_ = s.get("max_cuts", 0);
     hysteresis_ = s.get("hysteresis", 1.0);
     correction_ = s.get("correction", true);
+    // How the round-off floor is seen (theory §5.3): "residual" evaluates the residual of the accepted
+    // iterate and sees the stall there; "floor" (modified Newton's default) accepts u_k = u_{k−1} + Δu_k
+    // without its residual once u_{k−1}'s residual is within floor_margin of the floor of the recent steps.
+    const std::string certify = s.get("certify", std::string(nopt_.modified ? "floor" : "residual"));
+    if (certify != "residual" && certify != "floor")
+      throw std::invalid_argument("em-exact.certify: '" + certify + "' (use residual or floor)");
+    certify_floor_ = (certify == "floor");
+    nopt_.skip_final_residual = certify_floor_;
+    floor_margin_ = s.get("floor_margin", 1.5);
     if (!(res_tol_ > 0.0) || !(stall_tol_ >= 0.0) || !(stall_step_ >= 0.0) || !(stall_ratio_ > 0.0 && stall_ratio_ <= 1.0) ||
-        nopt_.max_iters < 1 || max_cuts_ < 0 || hysteresis_ < 1.0)
+        nopt_.max_iters < 1 || max_cuts_ < 0 || hysteresis_ < 1.0 || !(floor_margin_ >= 1.0))
       throw std::invalid_argument(
-          "em-exact: need res_tol > 0, stall_tol >= 0, stall_step >= 0, 0 < stall_ratio <= 1, max_iters >= 1, max_cuts >= 0, hysteresis >= 1");
+          "em-exact: need res_tol > 0, stall_tol >= 0, stall_step >= 0, 0 < stall_ratio <= 1, max_iters >= 1, max_cuts >= 0, "
+          "hysteresis >= 1, floor_margin >= 1");
     resolved_ = s.resolved();
     char b[64];
     std::snprintf(b, sizeof b, "%.10g", dt_);
@@ -102,6 +113,10 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
     c.scalars["diag_max_beta_z"] = diag_.max_beta_z;
     c.scalars["diag_rigid_guards"] = static_cast<double>(diag_.rigid_guards);
     c.scalars["diag_residual_work"] = diag_.residual_work;
+    c.scalars["diag_unevaluated_steps"] = static_cast<double>(diag_.unevaluated_steps);
+    // certify = floor: the floor of the recent steps (the next step's acceptance depends on it).
+    c.scalars["floor_estimate"] = floor_estimate_;
+    for (long j = 0; j < kFloorSteps; ++j) c.scalars["floor_" + std::to_string(j)] = recent_floor_[static_cast<size_t>(j)];
     kept_.save(c, *newton_, nopt_.modified);
   }
 
@@ -122,6 +137,12 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
     diag_.max_beta_z = c.scalar("diag_max_beta_z");
     diag_.rigid_guards = static_cast<long>(c.scalar("diag_rigid_guards"));
     diag_.residual_work = c.scalars.count("diag_residual_work") ? c.scalar("diag_residual_work") : 0.0;
+    diag_.unevaluated_steps = c.scalars.count("diag_unevaluated_steps") ? static_cast<long>(c.scalar("diag_unevaluated_steps")) : 0;
+    floor_estimate_ = c.scalars.count("floor_estimate") ? c.scalar("floor_estimate") : 0.0;
+    for (long j = 0; j < kFloorSteps; ++j) {
+      const std::string key = "floor_" + std::to_string(j);
+      recent_floor_[static_cast<size_t>(j)] = c.scalars.count(key) ? c.scalar(key) : 0.0;
+    }
     kept_.restore(c, *newton_, nopt_.modified, sys.pattern()->nnz(), "em-exact");
   }
 
@@ -140,8 +161,10 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
     M_ = model_->make_matrix();
     K_ = M_;
     for (Eigen::VectorXd* v : {&un_, &umid_, &fint_, &r_, &last_u_}) v->setZero(n);
-    for (Eigen::VectorXd* v : {&vn_, &wn_, &pn_, &p1_, &pmid_, &v1_, &w1_, &mv_, &mw_, &fd_, &g_}) v->setZero(3 * nn_);
+    for (Eigen::VectorXd* v : {&vn_, &wn_, &pn_, &p1_, &pmid_, &v1_, &w1_, &dv_, &dw_, &mv_, &mw_, &fd_, &g_}) v->setZero(3 * nn_);
     work_ = prescribed_work_ = 0.0;
+    floor_estimate_ = 0.0;
+    recent_floor_.fill(0.0);
     diag_ = Data{};
     diag_.min_step_dissipation = std::numeric_limits<double>::infinity();
     sys.rechart(s, hysteresis_);
@@ -212,9 +235,10 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
     w1_ = (2.0 / h) * (p1_ - pn_) - wn_;
     const ShellMaterial& mat = model_->material();
     const double rh = mat.rho * mat.thickness, rh3 = rh * mat.thickness * mat.thickness / 12.0;
-    model_->scalar_mass_times(v1_ - vn_, mv_);
+    dv_ = v1_ - vn_;
+    dw_ = w1_ - wn_;
+    model_->scalar_mass_times(dv_, dw_, mv_, mw_);
     mv_ *= rh / h;
-    model_->scalar_mass_times(w1_ - wn_, mw_);
     mw_ *= rh3 / h;
     model_->embedded_external(tmid, pmid_, fd_, g_);
   }
@@ -292,23 +316,38 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
       apply_dirichlet(sys.dofs(), J, nullptr);
       if (nopt_.modified && !full_newton) kept_.keep(J);  // for save()
     };
-    double first_step = 0.0;  // scaled size of the first correction
+    std::vector<double> steps;  // scaled size max_i |Δu_k,i| / max(1, |u_n,i|) of every correction
+    // The hook sees u_k, Δu_k and the residual history. With certify = residual it runs after r(u_k) was
+    // evaluated (history ends with ρ_k). With certify = floor it runs before (the solver's
+    // skip_final_residual: history ends with ρ_{k−1}); the residual and stall tests then accept the last
+    // evaluated iterate u_{k−1} (the one the same tests accept with certify = residual; Δu_k is discarded)
+    // and the floor test accepts u_k unevaluated (theory §5, §5.3).
+    bool accept_last_evaluated = false;
     auto hook = [&](int k, const double*, const double* du, const double*) -> bool {
       const double rk = history.back();
-      // max_i |Δu_k,i| / max(1, |u_n,i|), with the solver's scale uscale_ (set below, before solve()).
       const double step = (Eigen::Map<const Eigen::VectorXd>(du, n).cwiseAbs().array() * uscale_.array()).maxCoeff();
-      if (k == 1) first_step = step;
+      steps.push_back(step);
+      const double first_step = steps.front();
+      accept_last_evaluated = certify_floor_;
       if (rk <= res_tol_) return true;
       double prev_best = std::numeric_limits<double>::infinity();
       for (size_t j = 0; j + 1 < history.size(); ++j) prev_best = std::min(prev_best, history[j]);
+      const bool converged_step = step <= stall_step_ * first_step;
       if (rk <= stall_tol_ && rk > stall_ratio_ * prev_best) {
         // Stagnation at the round-off floor if the iteration matrix was fresh, or if the corrections have
         // already shrunk by stall_step relative to the first (the iteration converged; what stalls is the
         // residual's round-off, theory §5); otherwise refresh the matrix first.
-        if (last_jacobian_iter >= k - 1 || step <= stall_step_ * first_step) return true;
+        // (With certify = floor, "converged_step" reads Δu_k, one correction later than the stalled u_{k−1}.)
+        if (last_jacobian_iter >= k - 1 || converged_step) return true;
         newton.invalidate_jacobian();
+        return false;
       }
-      return false;
+      // certify = floor (theory §5.3): u_{k−1} is at the round-off floor when its residual is within
+      // floor_margin of the floor of the recent steps; u_k = u_{k−1} + Δu_k is then the iterate that the
+      // stall rule accepts after evaluating r(u_k), and it is accepted without that residual.
+      accept_last_evaluated = false;
+      return certify_floor_ && floor_estimate_ > 0.0 && converged_step && rk <= stall_tol_ &&
+             rk <= floor_margin_ * floor_estimate_;
     };
 
     Eigen::VectorXd u = un_;  // predictor u_{n+1} = u_n (theory §5)
@@ -340,7 +379,19 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
       *why = os.str();
       return false;
     }
-    u = last_u_;
+    // The accepted iterate: the last evaluated one, or (certify = floor, floor test) the solver's u_k,
+    // accepted before its residual was evaluated.
+    const bool evaluated = !certify_floor_ || accept_last_evaluated;
+    if (evaluated) u = last_u_;
+    // The floor of this step for the next ones: its smallest scaled residual (an iterate at the floor); the
+    // estimate is the median over the last kFloorSteps steps (it follows slow drift, e.g. as the body moves
+    // away from the origin, and ignores a single step far off).
+    recent_floor_[static_cast<size_t>(steps_ % kFloorSteps)] = *std::min_element(history.begin(), history.end());
+    if (steps_ + 1 >= kFloorSteps) {
+      std::array<double, kFloorSteps> f = recent_floor_;
+      std::nth_element(f.begin(), f.begin() + kFloorSteps / 2, f.end());
+      floor_estimate_ = f[kFloorSteps / 2];
+    }
     // Final quantities at the accepted iterate.
     kinematics(u, charts, h, tmid);
     if (xi_ > 0.0) {
@@ -351,12 +402,19 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
       diag_.max_beta_z = std::max(diag_.max_beta_z, fi.max_beta_z);
       diag_.rigid_guards += fi.rigid_guards;
     } else {
+      // The force at an accepted iterate whose residual was not evaluated, where it is needed (the reaction
+      // work of prescribed translations below).
+      if (!evaluated && !sys.prescribed_dofs().empty())
+        sys.exact_internal(un_, u, charts, Un_, correction_, 0.0, nullptr, fint_.data(), nullptr, nullptr, nullptr, &pmid_);
       diag_.max_beta_z = std::max(diag_.max_beta_z, finfo.max_beta_z);
       diag_.rigid_guards += finfo.rigid_guards;
       diag_.min_step_dissipation = std::min(diag_.min_step_dissipation, 0.0);
     }
     diag_.max_residual = std::max(diag_.max_residual, rep.residual_norm);
-    diag_.residual_work += (u - un_).dot(last_r_);  // constrained rows of r are zero
+    if (evaluated)
+      diag_.residual_work += (u - un_).dot(last_r_);  // constrained rows of r are zero
+    else
+      ++diag_.unevaluated_steps;
     // External work as the scheme evaluates it (theory §4): F_ext(t_mid)·Δd + Σ g_i·Δp_i.
     double dw = g_.dot(p1_ - pn_);
     for (int i = 0; i < nn_; ++i) {
@@ -397,6 +455,11 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
   int max_cuts_ = 0;
   double hysteresis_ = 1.0;
   bool correction_ = true;
+  bool certify_floor_ = false;  // certify = floor (theory §5.3)
+  double floor_margin_ = 1.5;
+  static constexpr long kFloorSteps = 16;
+  std::array<double, kFloorSteps> recent_floor_{};
+  double floor_estimate_ = 0.0;  // median smallest scaled residual of the last kFloorSteps steps (0: not yet)
   std::vector<std::pair<std::string, std::string>> resolved_;
 
   Model* model_ = nullptr;
@@ -406,7 +469,7 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
   std::vector<CR9Shell::Mat45> k0_;
   std::vector<double> Un_;
   Eigen::VectorXd un_, umid_, fint_, r_, last_u_, last_r_, uscale_;
-  Eigen::VectorXd vn_, wn_, pn_, p1_, pmid_, v1_, w1_, mv_, mw_, fd_, g_;
+  Eigen::VectorXd vn_, wn_, pn_, p1_, pmid_, v1_, w1_, dv_, dw_, mv_, mw_, fd_, g_;
   double work_ = 0.0, prescribed_work_ = 0.0;
   long steps_ = 0;
   Data diag_;

@@ -15,14 +15,17 @@
 //   contraction exceeds it], setup_every [20; 1e6 when refresh > 0], predictor none|trapezoidal [trapezoidal
 //   with modified Newton, else none], linear_solver [cholmod], solve_precision [double] (or single: float copy
 //   of the factor, docs/dependencies.md §5.5), res_tol [1e-12], stall_tol [1e-6], stall_ratio [0.5],
-//   stall_step [1e-6], max_iters [25], max_cuts [0], hysteresis [1],
+//   stall_step [1e-6], max_iters [25], max_cuts [0], hysteresis [1], certify residual|floor [floor with modified
+//   Newton, else residual] and floor_margin [1.5] (theory §5.3),
 //   correction [true] (false = the paper's force without the §3 correction: for tests that must fail).
 // Checkpoints (docs/architecture.md "Checkpoints and resume"): save/restore continue bitwise, with modified
 // Newton too; a stop request (SIGINT, --max-wall) is honoured at the next step boundary.
 // Stopping (theory §5): the scaled residual ‖r‖∞ / (‖inertia‖∞ + ‖F*‖∞ + ‖F_ext‖∞) ≤ res_tol, or, once it is
 // below stall_tol, an iteration that does not reduce the best residual by stall_ratio (the round-off floor of
 // the co-rotational force), accepted with a fresh K̄ or once the corrections have shrunk by stall_step
-// relative to the first; the last iterate is accepted (docs/theory/exact-energy-momentum.md §5, §5.1).
+// relative to the first; the last iterate is accepted (docs/theory/exact-energy-momentum.md §5, §5.1). With
+// certify = floor that iterate is accepted without evaluating its residual, once the one before it is
+// seen to be at the floor (§5.3).
 #pragma once
 
 #include "integrators/integrator.hpp"
@@ -44,7 +47,10 @@ class EmExactDiagnostics {
     long rigid_guards = 0;          // element-steps treated as rigid (β = 0)
     // Σ over steps of Δuᵀr, the work of the Newton residual r at the accepted iterate. By the energy
     // identity (docs/theory/exact-energy-momentum.md §4) this is the whole change of K + V + D − W_ext.
+    // Summed over the steps whose accepted iterate had its residual evaluated; the steps that certify =
+    // floor ended on its floor test accept u_k without its residual, and are counted instead.
     double residual_work = 0.0;
+    long unevaluated_steps = 0;
   };
   virtual const Data& diagnostics() const = 0;
 };
