@@ -156,7 +156,7 @@ class CR9Shell {
   // of §4.3 do not involve them): K_bs w then runs on the DOFs with a nonzero row only, as a dense block
   // (27 × 27 instead of the packed 45 × 45: 729 multiplications instead of 2 025). Empty when every row is nonzero.
   std::vector<int> kbs_active_;
-  Eigen::MatrixXd kbs_block_;
+  Eigen::MatrixXd kbs_block_;  // its product runs as a fixed-size one for the common sizes 27 (flat) and 36
   Vec45 kbs_times(const Vec45& w) const;  // Kbs_ w from Kbsp_ or kbs_block_
   Mat45 Kbs_;                           // constant bending + shear stiffness Σ dA (B_b^T M + B_s^T Q)
   std::array<Eigen::Matrix<double, 5, 45>, 9> Bbs_;  // [B_b; B_s] per Gauss point (output only)
