@@ -480,12 +480,13 @@ void CR9Shell::step_state(const Vec45& u_n, const Charts& charts, StepState* st)
 }
 
 double CR9Shell::step_energy(const StepState& st) const {
-  // internal()'s expressions: U = ½ wᵀ(K_bs w), then membrane()'s Σ_gp ½ dA εᵀ h D1 ε with the same ε.
-  const Vec45 f = Kbs_ * st.w;
+  // The residual's expressions (algorithmic_internal() without K): U = ½ wᵀ(K_bs w) with the state's K_bs w
+  // (kbs_times), then Σ_gp ½ dA εᵀ h D1 ε with the state's ε. So the U(u_{n+1}) a step ends with and the
+  // U(u_n) the next step starts from are the same number, and em-exact's ΔU telescope over the steps.
   const Eigen::Matrix3d hD1 = mat_.thickness * D1_;
   double Um = 0.0;
   for (size_t g = 0; g < gp_.size(); ++g) Um += membrane_energy(gp_[g].dA, st.e[g], hD1);
-  return 0.5 * st.w.dot(f) + Um;
+  return 0.5 * st.w.dot(st.Kw) + Um;
 }
 
 double CR9Shell::algorithmic_internal(const StepState& sn, const Vec45& u_n, const Vec45& u_np1, const Charts& charts,

@@ -75,8 +75,9 @@ class CR9Shell {
     std::array<Eigen::Vector3d, 9> e;  // ε_m at t_n per Gauss point
   };
   void step_state(const Vec45& u_n, const Charts& charts, StepState* st) const;
-  // The strain energy U(u_n) of a step state, with internal()'s expressions (so bitwise internal()'s energy at u_n)
-  // but without its frame and local variables: ½ wᵀ(K_bs w) + Σ_gp ½ dA εᵀ h D1 ε.
+  // The strain energy U(u_n) of a step state, with the expressions of algorithmic_internal()'s residual path (so
+  // bitwise the energy that a step's residual at u_{n+1} = u_n returns; internal()'s to round-off), without a
+  // frame or local variables: ½ wᵀ(K_bs w) + Σ_gp ½ dA εᵀ h D1 ε from the state's w, K_bs w and ε.
   double step_energy(const StepState& st) const;
   double algorithmic_internal(const StepState& sn, const Vec45& u_n, const Vec45& u_np1, const Charts& charts,
                               double alpha_f, double xi, Vec45* F, Mat45* K) const;
