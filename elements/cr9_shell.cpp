@@ -265,7 +265,7 @@ CR9Shell::Vec45 CR9Shell::kbs_times(const Vec45& w) const {
   // Flat elements (27 active DOFs) and the cylindrical panel's (36): fixed-size products.
   if (kbs_active_.size() == 27) return active_block_times<27>(kbs_block_.data(), kbs_active_, w);
   if (kbs_active_.size() == 36) return active_block_times<36>(kbs_block_.data(), kbs_active_, w);
-  if (!kbs_active_.empty()) {  // flat element: the dense block on the DOFs K_bs acts on
+  if (!kbs_active_.empty()) {  // other sizes: the dense block on the DOFs K_bs acts on
     const Eigen::Index na = kbs_block_.rows();
     Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 45, 1> wa(na), ya(na);
     for (Eigen::Index k = 0; k < na; ++k) wa(k) = w(kbs_active_[static_cast<size_t>(k)]);

@@ -84,11 +84,6 @@ RigidRows MidpointRigidRows::dense() const {
   return R;
 }
 
-RigidRows midpoint_rigid_rows(const NodeVectors& x_mid, const NodeVectors& p_mid,
-                              const std::array<DirectorChart, 9>& charts) {
-  return MidpointRigidRows(x_mid, p_mid, charts).dense();
-}
-
 CorrectionInfo energy_momentum_correction(const MidpointRigidRows& R, const Vec45E& du, double dU, Vec45E& F,
                                           double guard) {
   const Eigen::LLT<Eigen::Matrix<double, 6, 6>> RRt(R.gram());

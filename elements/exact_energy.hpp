@@ -50,10 +50,6 @@ class MidpointRigidRows {
   Eigen::Matrix<double, 6, 6> gram_;
 };
 
-// Rigid rows at the midpoint configuration (item 1), dense: MidpointRigidRows(x_mid, p_mid, charts).dense().
-RigidRows midpoint_rigid_rows(const NodeVectors& x_mid, const NodeVectors& p_mid,
-                              const std::array<DirectorChart, 9>& charts);
-
 struct CorrectionInfo {
   double beta = 0.0;         // the coefficient of z
   double z_norm2 = 0.0;      // zᵀz

@@ -114,8 +114,7 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
     c.scalars["diag_rigid_guards"] = static_cast<double>(diag_.rigid_guards);
     c.scalars["diag_residual_work"] = diag_.residual_work;
     c.scalars["diag_unevaluated_steps"] = static_cast<double>(diag_.unevaluated_steps);
-    // certify = floor: the floor of the recent steps (the next step's acceptance depends on it).
-    c.scalars["floor_estimate"] = floor_estimate_;
+    // certify = floor: the floors of the recent steps (the next step's acceptance depends on them).
     for (long j = 0; j < kFloorSteps; ++j) c.scalars["floor_" + std::to_string(j)] = recent_floor_[static_cast<size_t>(j)];
     kept_.save(c, *newton_, nopt_.modified);
   }
@@ -138,7 +137,6 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
     diag_.rigid_guards = static_cast<long>(c.scalar("diag_rigid_guards"));
     diag_.residual_work = c.scalars.count("diag_residual_work") ? c.scalar("diag_residual_work") : 0.0;
     diag_.unevaluated_steps = c.scalars.count("diag_unevaluated_steps") ? static_cast<long>(c.scalar("diag_unevaluated_steps")) : 0;
-    floor_estimate_ = c.scalars.count("floor_estimate") ? c.scalar("floor_estimate") : 0.0;
     for (long j = 0; j < kFloorSteps; ++j) {
       const std::string key = "floor_" + std::to_string(j);
       recent_floor_[static_cast<size_t>(j)] = c.scalars.count(key) ? c.scalar(key) : 0.0;
@@ -163,7 +161,6 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
     for (Eigen::VectorXd* v : {&un_, &umid_, &fint_, &r_, &last_u_}) v->setZero(n);
     for (Eigen::VectorXd* v : {&vn_, &wn_, &pn_, &p1_, &pmid_, &v1_, &w1_, &dv_, &dw_, &mv_, &mw_, &fd_, &g_}) v->setZero(3 * nn_);
     work_ = prescribed_work_ = 0.0;
-    floor_estimate_ = 0.0;
     recent_floor_.fill(0.0);
     diag_ = Data{};
     diag_.min_step_dissipation = std::numeric_limits<double>::infinity();
@@ -216,6 +213,16 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
     }
     step_with_cuts(s, 0.5 * h, depth + 1, rep);
     step_with_cuts(s, 0.5 * h, depth + 1, rep);
+  }
+
+  // The round-off floor of the recent steps (certify = floor): the median of the smallest scaled residuals of
+  // the last kFloorSteps steps, which follows slow drift (e.g. as the body moves away from the origin) and
+  // ignores a single step far off; 0 until kFloorSteps steps have been taken.
+  double floor_estimate() const {
+    if (steps_ < kFloorSteps) return 0.0;
+    std::array<double, kFloorSteps> f = recent_floor_;
+    std::nth_element(f.begin(), f.begin() + kFloorSteps / 2, f.end());
+    return f[kFloorSteps / 2];
   }
 
   // Directors p(q) of all nodes (3 per node) in the step's charts.
@@ -316,7 +323,8 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
       apply_dirichlet(sys.dofs(), J, nullptr);
       if (nopt_.modified && !full_newton) kept_.keep(J);  // for save()
     };
-    std::vector<double> steps;  // scaled size max_i |Δu_k,i| / max(1, |u_n,i|) of every correction
+    double first_step = 0.0;  // scaled size of the first correction
+    const double recent_floor = floor_estimate();  // certify = floor
     // The hook sees u_k, Δu_k and the residual history. With certify = residual it runs after r(u_k) was
     // evaluated (history ends with ρ_k). With certify = floor it runs before (the solver's
     // skip_final_residual: history ends with ρ_{k−1}); the residual and stall tests then accept the last
@@ -326,8 +334,7 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
     auto hook = [&](int k, const double*, const double* du, const double*) -> bool {
       const double rk = history.back();
       const double step = (Eigen::Map<const Eigen::VectorXd>(du, n).cwiseAbs().array() * uscale_.array()).maxCoeff();
-      steps.push_back(step);
-      const double first_step = steps.front();
+      if (k == 1) first_step = step;
       accept_last_evaluated = certify_floor_;
       if (rk <= res_tol_) return true;
       double prev_best = std::numeric_limits<double>::infinity();
@@ -346,8 +353,7 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
       // floor_margin of the floor of the recent steps; u_k = u_{k−1} + Δu_k is then the iterate that the
       // stall rule accepts after evaluating r(u_k), and it is accepted without that residual.
       accept_last_evaluated = false;
-      return certify_floor_ && floor_estimate_ > 0.0 && converged_step && rk <= stall_tol_ &&
-             rk <= floor_margin_ * floor_estimate_;
+      return certify_floor_ && recent_floor > 0.0 && converged_step && rk <= stall_tol_ && rk <= floor_margin_ * recent_floor;
     };
 
     Eigen::VectorXd u = un_;  // predictor u_{n+1} = u_n (theory §5)
@@ -383,15 +389,8 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
     // accepted before its residual was evaluated.
     const bool evaluated = !certify_floor_ || accept_last_evaluated;
     if (evaluated) u = last_u_;
-    // The floor of this step for the next ones: its smallest scaled residual (an iterate at the floor); the
-    // estimate is the median over the last kFloorSteps steps (it follows slow drift, e.g. as the body moves
-    // away from the origin, and ignores a single step far off).
+    // The floor of this step for the next ones: its smallest scaled residual (an iterate at the floor).
     recent_floor_[static_cast<size_t>(steps_ % kFloorSteps)] = *std::min_element(history.begin(), history.end());
-    if (steps_ + 1 >= kFloorSteps) {
-      std::array<double, kFloorSteps> f = recent_floor_;
-      std::nth_element(f.begin(), f.begin() + kFloorSteps / 2, f.end());
-      floor_estimate_ = f[kFloorSteps / 2];
-    }
     // Final quantities at the accepted iterate.
     kinematics(u, charts, h, tmid);
     if (xi_ > 0.0) {
@@ -457,7 +456,6 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
   double floor_margin_ = 1.5;
   static constexpr long kFloorSteps = 16;
   std::array<double, kFloorSteps> recent_floor_{};
-  double floor_estimate_ = 0.0;  // median smallest scaled residual of the last kFloorSteps steps (0: not yet)
   std::vector<std::pair<std::string, std::string>> resolved_;
 
   Model* model_ = nullptr;
