@@ -54,29 +54,52 @@ TEST(CR9Algorithmic, StepStateOverloadIsBitwiseTheSame) {
 // step_energy(StepState) is U(u_n) by the residual path's expressions: bitwise the energy that
 // algorithmic_internal() (F only, as in a residual) returns for u_{n+1} = u, so that the U(u_{n+1}) a step ends
 // with is the U(u_n) the next step starts from and em-exact's ΔU telescope. internal()'s energy (the dense K_bs
-// product) agrees to round-off. The state of another configuration has another energy (the test can fail).
+// product) agrees to round-off: it differs in the last bit for about one state in twenty, which is why the test
+// runs 40 pairs per geometry (with the dense product in step_energy it fails). The state of another
+// configuration has another energy (the test can fail).
+
+// The flat element mapped onto a sphere of radius 2 (normals radial): doubly curved, so K_bs has no zero rows
+// and its product runs the packed symmetric path.
+Geometry spherical_patch() {
+  Geometry g = make_geometry(Shape::Flat, Facing::Z);
+  const double R = 2.0;
+  for (size_t i = 0; i < g.X0.size(); ++i) {
+    const Eigen::Vector3d v(g.X0[i].x(), g.X0[i].y(), R);
+    g.p0[i] = v.normalized();
+    g.X0[i] = R * g.p0[i];
+  }
+  g.name = "spherical patch";
+  return g;
+}
+
 TEST(CR9Algorithmic, StepStateEnergyIsTheResidualsEnergy) {
   double worst = 0.0;
-  for (Shape shape : {Shape::Flat, Shape::Distorted, Shape::Cylinder}) {
-    const Geometry g = make_geometry(shape, Facing::Z);
+  int last_bit = 0;  // pairs whose energy differs from internal()'s
+  for (int shape = 0; shape < 4; ++shape) {
+    const Geometry g = shape < 3 ? make_geometry(static_cast<Shape>(shape), Facing::Z) : spherical_patch();
     const CR9Shell e(g.X0, g.p0, test_material());
-    Charts ch;
-    const Vec45 un = random_state(g, 0.05, 0.6, 31, &ch);
-    const Vec45 u1 = un + random_vector(0.01, 37);
-    CR9Shell::StepState sn, s1;
-    e.step_state(un, ch, &sn);
-    e.step_state(u1, ch, &s1);
-    const double Un = e.step_energy(sn), U1 = e.step_energy(s1);
-    Vec45 F;
-    EXPECT_EQ(U1, e.algorithmic_internal(sn, un, u1, ch, 0.5, 0.0, &F, nullptr));  // the step from u_n ends with U1
-    EXPECT_EQ(Un, e.algorithmic_internal(s1, u1, un, ch, 0.5, 0.0, &F, nullptr));  // and the reverse step with Un
-    const double rel = std::max(std::abs(Un - e.internal(un, ch, nullptr, nullptr)) / std::abs(Un),
-                                std::abs(U1 - e.internal(u1, ch, nullptr, nullptr)) / std::abs(U1));
-    worst = std::max(worst, rel);
-    EXPECT_LT(rel, 1e-14);
-    EXPECT_GT(std::abs(U1 - Un), 1e-6 * std::abs(Un));
+    for (unsigned seed = 1; seed <= 40; ++seed) {
+      Charts ch;
+      const Vec45 un = random_state(g, 0.05, 0.6, seed, &ch);
+      const Vec45 u1 = un + random_vector(0.01, seed + 100);
+      CR9Shell::StepState sn, s1;
+      e.step_state(un, ch, &sn);
+      e.step_state(u1, ch, &s1);
+      const double Un = e.step_energy(sn), U1 = e.step_energy(s1);
+      Vec45 F;
+      // The step from u_n ends with U1, and the reverse step with Un.
+      EXPECT_EQ(U1, e.algorithmic_internal(sn, un, u1, ch, 0.5, 0.0, &F, nullptr)) << g.name << " seed " << seed;
+      EXPECT_EQ(Un, e.algorithmic_internal(s1, u1, un, ch, 0.5, 0.0, &F, nullptr)) << g.name << " seed " << seed;
+      const double In = e.internal(un, ch, nullptr, nullptr), I1 = e.internal(u1, ch, nullptr, nullptr);
+      last_bit += (Un != In) + (U1 != I1);
+      const double rel = std::max(std::abs(Un - In) / std::abs(Un), std::abs(U1 - I1) / std::abs(U1));
+      worst = std::max(worst, rel);
+      EXPECT_LT(rel, 1e-14);
+      EXPECT_GT(std::abs(U1 - Un), 1e-6 * std::abs(Un));
+    }
   }
-  std::printf("step_energy against internal()'s energy: max relative difference %.2e\n", worst);
+  std::printf("step_energy against internal()'s energy: %d of 320 energies differ, max relative difference %.2e\n",
+              last_bit, worst);
 }
 
 // §6.7(a): with alpha_f = 1/2, xi = 0 the local part is exact (ε quadratic in u_L), but u_L(u_G) is
