@@ -67,13 +67,20 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
     correction_ = s.get("correction", true);
     // How the round-off floor is seen (theory §5.3): "residual" evaluates the residual of the accepted
     // iterate and sees the stall there; "floor" (modified Newton's default) accepts u_k = u_{k−1} + Δu_k
-    // without its residual once u_{k−1}'s residual is within floor_margin of the floor of the recent steps.
+    // without its residual once u_{k−1}'s residual is within floor_margin of the floor of the recent steps;
+    // "predicted" (theory §5.4) also accepts u_k unevaluated once the residual it is predicted to have,
+    // ρ_{k−1}²/ρ_{k−2}, is within floor_margin/predict_factor of that floor (one correction earlier, not exact to
+    // the floor: a trade of conservation for iterations, measured in §5.4).
     const std::string certify = s.get("certify", std::string(nopt_.modified ? "floor" : "residual"));
-    if (certify != "residual" && certify != "floor")
-      throw std::invalid_argument("em-exact.certify: '" + certify + "' (use residual or floor)");
-    certify_floor_ = (certify == "floor");
+    if (certify != "residual" && certify != "floor" && certify != "predicted")
+      throw std::invalid_argument("em-exact.certify: '" + certify + "' (use residual, floor or predicted)");
+    certify_floor_ = (certify != "residual");
+    predicted_ = (certify == "predicted");
     nopt_.skip_final_residual = certify_floor_;
     floor_margin_ = s.get("floor_margin", 1.5);
+    predict_factor_ = s.get("predict_factor", 1.0);
+    if (!(predict_factor_ > 0.0) || !std::isfinite(predict_factor_))
+      throw std::invalid_argument("em-exact.predict_factor must be > 0 (a safety factor on the predicted residual, theory §5.4)");
     if (!(res_tol_ > 0.0) || !(stall_tol_ >= 0.0) || !(stall_step_ >= 0.0) || !(stall_ratio_ > 0.0 && stall_ratio_ <= 1.0) ||
         nopt_.max_iters < 1 || max_cuts_ < 0 || hysteresis_ < 1.0 || !(floor_margin_ >= 1.0))
       throw std::invalid_argument(
@@ -217,12 +224,21 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
 
   // The round-off floor of the recent steps (certify = floor): the median of the smallest scaled residuals of
   // the last kFloorSteps steps, which follows slow drift (e.g. as the body moves away from the origin) and
-  // ignores a single step far off; 0 until kFloorSteps steps have been taken.
+  // ignores a single step far off; 0 until kFloorSteps steps have been taken. With certify = predicted the steps
+  // stop short of the floor, so only every kFloorSteps-th step iterates to it and is recorded (measures_floor()):
+  // the ring then spans kFloorSteps² steps.
   double floor_estimate() const {
     if (steps_ < kFloorSteps) return 0.0;
     std::array<double, kFloorSteps> f = recent_floor_;
     std::nth_element(f.begin(), f.begin() + kFloorSteps / 2, f.end());
     return f[kFloorSteps / 2];
+  }
+
+  // Whether the step about to be taken measures the floor (always but with certify = predicted, theory §5.4).
+  bool measures_floor() const { return !predicted_ || steps_ < kFloorSteps || steps_ % kFloorSteps == 0; }
+  // The ring slot of the step about to be taken.
+  size_t floor_slot() const {
+    return static_cast<size_t>((predicted_ && steps_ >= kFloorSteps ? steps_ / kFloorSteps : steps_) % kFloorSteps);
   }
 
   // Directors p(q) of all nodes (3 per node) in the step's charts.
@@ -324,7 +340,9 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
       if (nopt_.modified && !full_newton) kept_.keep(J);  // for save()
     };
     double first_step = 0.0;  // scaled size of the first correction
-    const double recent_floor = floor_estimate();  // certify = floor
+    double prev_step = 0.0;   // scaled size of the previous correction (certify = predicted)
+    const double recent_floor = floor_estimate();  // certify = floor, predicted
+    const bool predict = predicted_ && !measures_floor();
     // The hook sees u_k, Δu_k and the residual history. With certify = residual it runs after r(u_k) was
     // evaluated (history ends with ρ_k). With certify = floor it runs before (the solver's
     // skip_final_residual: history ends with ρ_{k−1}); the residual and stall tests then accept the last
@@ -335,6 +353,8 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
       const double rk = history.back();
       const double step = (Eigen::Map<const Eigen::VectorXd>(du, n).cwiseAbs().array() * uscale_.array()).maxCoeff();
       if (k == 1) first_step = step;
+      const double step_before = prev_step;
+      prev_step = step;
       accept_last_evaluated = certify_floor_;
       if (rk <= res_tol_) return true;
       double prev_best = std::numeric_limits<double>::infinity();
@@ -353,7 +373,15 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
       // floor_margin of the floor of the recent steps; u_k = u_{k−1} + Δu_k is then the iterate that the
       // stall rule accepts after evaluating r(u_k), and it is accepted without that residual.
       accept_last_evaluated = false;
-      return certify_floor_ && recent_floor > 0.0 && converged_step && rk <= stall_tol_ && rk <= floor_margin_ * recent_floor;
+      if (certify_floor_ && recent_floor > 0.0 && converged_step && rk <= stall_tol_ && rk <= floor_margin_ * recent_floor)
+        return true;
+      // certify = predicted (theory §5.4): u_k unevaluated when the iteration contracts (residual and correction)
+      // and the residual it predicts for u_k, ρ_{k−1}·(ρ_{k−1}/ρ_{k−2}), is within the floor's margin. Not from
+      // ρ_1/ρ_0: the first correction removes the predictor's error far better than the later ones contract
+      // (hemisphere: 1e-7 against 1e-3), so that ratio would predict the floor two corrections too early.
+      if (!predict || recent_floor <= 0.0 || history.size() < 3 || rk > stall_tol_) return false;
+      const double rp = history[history.size() - 2];
+      return rk < rp && step < 0.5 * step_before && predict_factor_ * rk * (rk / rp) <= floor_margin_ * recent_floor;
     };
 
     Eigen::VectorXd u = un_;  // predictor u_{n+1} = u_n (theory §5)
@@ -390,7 +418,7 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
     const bool evaluated = !certify_floor_ || accept_last_evaluated;
     if (evaluated) u = last_u_;
     // The floor of this step for the next ones: its smallest scaled residual (an iterate at the floor).
-    recent_floor_[static_cast<size_t>(steps_ % kFloorSteps)] = *std::min_element(history.begin(), history.end());
+    if (measures_floor()) recent_floor_[floor_slot()] = *std::min_element(history.begin(), history.end());
     // Final quantities at the accepted iterate.
     kinematics(u, charts, h, tmid);
     if (xi_ > 0.0) {
@@ -452,8 +480,10 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
   int max_cuts_ = 0;
   double hysteresis_ = 1.0;
   bool correction_ = true;
-  bool certify_floor_ = false;  // certify = floor (theory §5.3)
+  bool certify_floor_ = false;  // certify = floor or predicted (theory §5.3)
+  bool predicted_ = false;      // certify = predicted (theory §5.4)
   double floor_margin_ = 1.5;
+  double predict_factor_ = 1.0;
   static constexpr long kFloorSteps = 16;
   std::array<double, kFloorSteps> recent_floor_{};
   std::vector<std::pair<std::string, std::string>> resolved_;

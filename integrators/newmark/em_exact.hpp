@@ -15,8 +15,9 @@
 //   contraction exceeds it], setup_every [20; 1e6 when refresh > 0], predictor none|trapezoidal [trapezoidal
 //   with modified Newton, else none], linear_solver [cholmod], solve_precision [double] (or single: float copy
 //   of the factor, docs/dependencies.md §5.5), res_tol [1e-12], stall_tol [1e-6], stall_ratio [0.5],
-//   stall_step [1e-6], max_iters [25], max_cuts [0], hysteresis [1], certify residual|floor [floor with modified
-//   Newton, else residual] and floor_margin [1.5] (theory §5.3),
+//   stall_step [1e-6], max_iters [25], max_cuts [0], hysteresis [1], certify residual|floor|predicted [floor with
+//   modified Newton, else residual] and floor_margin [1.5] (theory §5.3), predict_factor [1] (certify = predicted:
+//   safety factor on the predicted residual, theory §5.4),
 //   correction [true] (false = the paper's force without the §3 correction: for tests that must fail).
 // Checkpoints (docs/architecture.md "Checkpoints and resume"): save/restore continue bitwise, with modified
 // Newton too; a stop request (SIGINT, --max-wall) is honoured at the next step boundary.
@@ -25,7 +26,8 @@
 // the co-rotational force), accepted with a fresh K̄ or once the corrections have shrunk by stall_step
 // relative to the first; the last iterate is accepted (docs/theory/exact-energy-momentum.md §5, §5.1). With
 // certify = floor that iterate is accepted without evaluating its residual, once the one before it is
-// seen to be at the floor (§5.3).
+// seen to be at the floor (§5.3). certify = predicted accepts one correction earlier, once the contraction
+// predicts the floor for the iterate (§5.4): fewer iterations, a larger (still round-off-sized) energy error.
 #pragma once
 
 #include "integrators/integrator.hpp"
@@ -48,7 +50,8 @@ class EmExactDiagnostics {
     // Σ over steps of Δuᵀr, the work of the Newton residual r at the accepted iterate. By the energy
     // identity (docs/theory/exact-energy-momentum.md §4) this is the whole change of K + V + D − W_ext.
     // Summed over the steps whose accepted iterate had its residual evaluated; the steps that certify =
-    // floor ended on its floor test accept u_k without its residual, and are counted instead.
+    // floor or predicted ended on its floor or prediction test accept u_k without its residual, and are
+    // counted instead.
     double residual_work = 0.0;
     long unevaluated_steps = 0;
   };

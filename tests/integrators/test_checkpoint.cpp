@@ -228,6 +228,13 @@ TEST(CheckpointEmExact, ModifiedNewtonContinuesBitwiseAtEveryRefreshPhase) {
     expect_bitwise_continuation("em-exact", {{"newton", "modified"}, {"setup_every", "2"}}, stop_after);
 }
 
+// certify = predicted measures the floor only every 16th step (theory §5.4): the continued run must keep that
+// schedule and the ring of measured floors. Stops on both sides of the measuring step 32.
+TEST(CheckpointEmExact, PredictedCertifyContinuesBitwise) {
+  for (int stop_after : {1, 11, 12, 13})
+    expect_bitwise_continuation("em-exact", {{"newton", "modified"}, {"certify", "predicted"}}, stop_after);
+}
+
 // ida-bdf restarts from the saved state (re-initialization): not bitwise; the continued run must agree
 // with the uninterrupted one to the level of its tolerances. Measured: see the bound below.
 TEST(CheckpointSundials, IdaBdfRestartsFromTheSavedState) {

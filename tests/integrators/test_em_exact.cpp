@@ -182,6 +182,17 @@ TEST(EmExact, ModifiedNewtonKeepsTheBalances) {
               double(r.residuals) / r.steps, double(rr.residuals) / rr.steps, r.unevaluated_steps, r.steps);
   EXPECT_GT(r.unevaluated_steps, r.steps / 4);
   EXPECT_LT(r.residuals, rr.residuals);
+  // certify = predicted (theory §5.4) stops a correction earlier still, on the residual predicted from the
+  // contraction: fewer residuals, the balances within the same bounds.
+  auto predicted = modified;
+  predicted.emplace_back("certify", "predicted");
+  const Flight rp = fly("em-exact", 1e6, 0.01, 200, kV0, kW, 0.5, predicted);
+  print("  same, certify = predicted", rp);
+  std::printf("  residuals per step: certify predicted %.2f\n", double(rp.residuals) / rp.steps);
+  EXPECT_LT(rp.max_dH, 1e-10);
+  EXPECT_LT(rp.max_dJ, 1e-9);
+  EXPECT_LT(rp.max_dL, 1e-12);
+  EXPECT_LT(rp.residuals, r.residuals);
   auto u_n = modified;
   u_n.emplace_back("predictor", "none");
   const Flight r0 = fly("em-exact", 1e6, 0.01, 200, kV0, kW, 0.5, u_n);
@@ -330,6 +341,8 @@ TEST(EmExact, RejectsBadSettingsAndOtherSystems) {
   EXPECT_THROW(make("em-exact", 0.01, {{"newton", "quasi"}}), std::invalid_argument);
   EXPECT_THROW(make("em-exact", 0.01, {{"certify", "contraction"}}), std::invalid_argument);
   EXPECT_THROW(make("em-exact", 0.01, {{"floor_margin", "0.5"}}), std::invalid_argument);
+  EXPECT_THROW(make("em-exact", 0.01, {{"certify", "predicted"}, {"predict_factor", "0"}}), std::invalid_argument);
+  EXPECT_THROW(make("em-exact", 0.01, {{"predict_factor", "nan"}}), std::invalid_argument);
   EXPECT_THROW(make("em-exact", -0.01), std::invalid_argument);
   EXPECT_THROW(make("em-exact", 0.01, {{"cc_tol", "1e-6"}}), std::invalid_argument);  // not an em-exact key
   testing::SpringMass spring(1.0);
