@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "elements/cr9_shell.hpp"
+#include "elements/exact_energy.hpp"
 #include "elements/shape_functions.hpp"
 
 namespace {
@@ -110,6 +111,32 @@ void BM_AlgorithmicForceStepState256(benchmark::State& state) {
   state.SetItemsProcessed(state.iterations() * static_cast<int64_t>(els.size()));
 }
 BENCHMARK(BM_AlgorithmicForceStepState256)->Unit(benchmark::kMillisecond);
+
+// What em-exact adds per element and residual to em-galpha's force (docs/theory/exact-energy-momentum.md §3):
+// the midpoint rigid rows from the nodal vectors and the correction (one 6 × 6 solve for both right-hand sides).
+void BM_ExactCorrection(benchmark::State& state) {
+  const Setup s = make_setup();
+  const CR9Shell e(s.X0, s.p0, kMat);
+  CR9Shell::StepState sn;
+  e.step_state(s.u, s.charts, &sn);
+  CR9Shell::Vec45 F;
+  const double U1 = e.algorithmic_internal(sn, s.u, s.u1, s.charts, 0.5, 0.0, &F, nullptr);
+  const double dU = U1 - e.step_energy(sn);
+  NodeVectors xm, pm;
+  for (int a = 0; a < 9; ++a) {
+    xm[a] = s.X0[a] + 0.5 * (s.u.segment<3>(5 * a) + s.u1.segment<3>(5 * a));
+    pm[a] = 0.5 * (director(s.u.segment<2>(5 * a + 3), s.charts[a]) + director(s.u1.segment<2>(5 * a + 3), s.charts[a]));
+  }
+  const CR9Shell::Vec45 du = s.u1 - s.u;
+  for (auto _ : state) {
+    CR9Shell::Vec45 f = F;
+    const MidpointRigidRows R(xm, pm, s.charts);
+    benchmark::DoNotOptimize(energy_momentum_correction(R, du, dU, f));
+    benchmark::DoNotOptimize(f.data());
+    benchmark::ClobberMemory();
+  }
+}
+BENCHMARK(BM_ExactCorrection)->Unit(benchmark::kMicrosecond);
 
 void BM_StepState(benchmark::State& state) {
   const Setup s = make_setup();
