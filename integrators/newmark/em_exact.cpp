@@ -37,7 +37,13 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
     nopt_.modified = (newton == "modified");
     // Modified Newton keeps K̄ while the iteration contracts (as em-galpha: refresh when the observed
     // contraction ‖Δu_k‖/‖Δu_{k−1}‖ exceeds `refresh`; refresh = 0 restores the fixed count setup_every).
-    nopt_.refresh_contraction = s.get("refresh", nopt_.modified ? 0.03 : 0.0);
+    // Opt-in (theory §5.5): refresh_cost > 0 refreshes K̄ when a step's iterations exceed the average cost per
+    // step since the last refresh, the refresh counted as refresh_cost iterations (the renewal rule); the
+    // contraction test then only guards against a K̄ that converges too slowly for the stall rule (refresh 0.2).
+    refresh_cost_ = s.get("refresh_cost", 0.0);
+    if (!(refresh_cost_ >= 0.0) || !std::isfinite(refresh_cost_))
+      throw std::invalid_argument("em-exact.refresh_cost must be >= 0 (a refresh's cost in iterations; 0 = off)");
+    nopt_.refresh_contraction = s.get("refresh", nopt_.modified ? (refresh_cost_ > 0.0 ? 0.2 : 0.03) : 0.0);
     nopt_.max_setup_calls = s.get("setup_every", nopt_.refresh_contraction > 0 ? 1000000 : 20);
     // CHOLMOD's supernodal Cholesky as em-galpha (faster solves than Eigen's simplicial LDLᵀ, no hidden threads).
     nopt_.linear_solver = s.get("linear_solver", "cholmod");
@@ -121,6 +127,8 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
     c.scalars["diag_rigid_guards"] = static_cast<double>(diag_.rigid_guards);
     c.scalars["diag_residual_work"] = diag_.residual_work;
     c.scalars["diag_unevaluated_steps"] = static_cast<double>(diag_.unevaluated_steps);
+    c.scalars["renew_steps"] = static_cast<double>(renew_steps_);  // the renewal rule's count (theory §5.5)
+    c.scalars["renew_iterations"] = static_cast<double>(renew_iterations_);
     // certify = floor: the floors of the recent steps (the next step's acceptance depends on them).
     for (long j = 0; j < kFloorSteps; ++j) c.scalars["floor_" + std::to_string(j)] = recent_floor_[static_cast<size_t>(j)];
     kept_.save(c, *newton_, nopt_.modified);
@@ -144,6 +152,8 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
     diag_.rigid_guards = static_cast<long>(c.scalar("diag_rigid_guards"));
     diag_.residual_work = c.scalars.count("diag_residual_work") ? c.scalar("diag_residual_work") : 0.0;
     diag_.unevaluated_steps = c.scalars.count("diag_unevaluated_steps") ? static_cast<long>(c.scalar("diag_unevaluated_steps")) : 0;
+    renew_steps_ = c.scalars.count("renew_steps") ? static_cast<long>(c.scalar("renew_steps")) : 0;
+    renew_iterations_ = c.scalars.count("renew_iterations") ? static_cast<long>(c.scalar("renew_iterations")) : 0;
     for (long j = 0; j < kFloorSteps; ++j) {
       const std::string key = "floor_" + std::to_string(j);
       recent_floor_[static_cast<size_t>(j)] = c.scalars.count(key) ? c.scalar(key) : 0.0;
@@ -169,6 +179,7 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
     for (Eigen::VectorXd* v : {&vn_, &wn_, &pn_, &p1_, &pmid_, &v1_, &w1_, &dv_, &dw_, &mv_, &mw_, &fd_, &g_}) v->setZero(3 * nn_);
     work_ = prescribed_work_ = 0.0;
     recent_floor_.fill(0.0);
+    renew_steps_ = renew_iterations_ = 0;
     diag_ = Data{};
     diag_.min_step_dissipation = std::numeric_limits<double>::infinity();
     sys.rechart(s, hysteresis_);
@@ -401,6 +412,21 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
     uscale_ = (1.0 / un_.array().abs().max(1.0)).matrix();
     const NewtonSolver::Result r = newton.solve(u.data(), residual, jacobian, nullptr, uscale_.data(), hook);
     if (full_newton) newton_->invalidate_jacobian();
+    // The renewal rule (theory §5.5), modified Newton only: after a step that kept K̄, refresh it for the next
+    // step when this step's iterations exceed the average since the last refresh, (refresh_cost + Σ it)/steps.
+    // A replayed K̄ (restore()) is the uninterrupted run's, not a refresh.
+    if (refresh_cost_ > 0.0 && nopt_.modified && !full_newton && r.converged) {
+      if (r.jacobian_evals - (replayed ? 1 : 0) > 0) {
+        renew_steps_ = 0;
+        renew_iterations_ = 0;
+      } else {
+        ++renew_steps_;
+        renew_iterations_ += r.iterations;
+        if (static_cast<double>(r.iterations) * static_cast<double>(renew_steps_) >
+            refresh_cost_ + static_cast<double>(renew_iterations_))
+          newton.invalidate_jacobian();
+      }
+    }
     rep.nonlinear_iterations += r.iterations;
     // A replayed K̄ (restore()) is the uninterrupted run's matrix, not a new setup: not counted.
     rep.linear_setups += r.jacobian_evals - (replayed ? 1 : 0);
@@ -484,6 +510,9 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
   bool predicted_ = false;      // certify = predicted (theory §5.4)
   double floor_margin_ = 1.5;
   double predict_factor_ = 1.0;
+  double refresh_cost_ = 0.0;   // renewal rule (theory §5.5); 0 = off
+  long renew_steps_ = 0;        // steps since the last refresh of K̄
+  long renew_iterations_ = 0;   // their iterations
   static constexpr long kFloorSteps = 16;
   std::array<double, kFloorSteps> recent_floor_{};
   std::vector<std::pair<std::string, std::string>> resolved_;
