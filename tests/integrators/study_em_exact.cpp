@@ -121,6 +121,11 @@ TEST(EmExactStudy, DISABLED_TumblingPlate200sModifiedNewton) {
     EXPECT_LT(r.max_dH, 1e-10);
     EXPECT_LT(r.max_dJ, 1e-9);
   }
+  // The renewal refresh (refresh_cost, §5.5) with the default certify = floor.
+  const Long r = spin({0.01, 1.0, 0.01}, 0.01, "renewal", "em-exact", {{"newton", "modified"}, {"refresh_cost", "12"}});
+  EXPECT_LT(r.max_strain, 1e-6);
+  EXPECT_LT(r.max_dH, 1e-10);
+  EXPECT_LT(r.max_dJ, 1e-9);
 }
 
 }  // namespace
