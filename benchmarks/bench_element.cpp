@@ -80,8 +80,6 @@ void BM_AlgorithmicForceAndTangent(benchmark::State& state) {
 }
 BENCHMARK(BM_AlgorithmicForceAndTangent)->Unit(benchmark::kMicrosecond);
 
-// What a residual of em-galpha costs per element: the strain-averaged force with the step's state at u_n
-// (computed once per step, outside the loop) and without a tangent.
 // The element's step state at the setup's u_n (what a model caches once per step).
 CR9Shell::StepState state_at_un(const CR9Shell& e, const Setup& s) {
   CR9Shell::StepState sn;
@@ -89,6 +87,8 @@ CR9Shell::StepState state_at_un(const CR9Shell& e, const Setup& s) {
   return sn;
 }
 
+// What a residual of em-galpha costs per element: the strain-averaged force with the step's state at u_n
+// (computed once per step, outside the loop) and without a tangent.
 void BM_AlgorithmicForceStepState(benchmark::State& state) {
   const Setup s = make_setup();
   const CR9Shell e(s.X0, s.p0, kMat);

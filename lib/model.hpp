@@ -117,8 +117,9 @@ class Model final : public SemiDiscreteSystem {
   void scalar_mass_times(const Eigen::VectorXd& x, const Eigen::VectorXd& y, Eigen::VectorXd& mx,
                          Eigen::VectorXd& my) const;
   // Strain energy U_e(u_n) of every element at the start u_n of a step (U.size() = number of elements), from the
-  // step's element states (CR9Shell::step_energy(): bitwise the energy the previous step's residual returned
-  // at its accepted iterate), so no frames or local variables of its own when the step's states are needed anyway.
+  // step's element states (CR9Shell::step_energy(): bitwise the energy a residual evaluated at u_n returns, the
+  // expression the previous step's U(u_{n+1}) used), so no frames or local variables of its own when the step's
+  // states are needed anyway.
   void step_energies(const Eigen::VectorXd& u_n, const std::vector<DirectorChart>& charts, std::vector<double>& U) const;
   // Linear local stiffness k_L at the stress-free reference state of element e (symmetric PSD, zero on rigid modes).
   CR9Shell::Mat45 reference_local_stiffness(int e) const;
