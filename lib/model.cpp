@@ -3,6 +3,8 @@
 #include "elements/exact_energy.hpp"
 #include "lib/profile.hpp"
 
+#include <Eigen/SVD>
+
 #include <algorithm>
 #include <cmath>
 #include <cstring>
@@ -403,6 +405,70 @@ int Model::rechart(State& s, double hysteresis) {
   }
   if (switched) dofs_.resolve(s.charts);
   return switched;
+}
+
+bool Model::kept_matrix_basis(const Eigen::VectorXd& u_ref, const std::vector<DirectorChart>& charts_ref,
+                              const Eigen::VectorXd& u, const std::vector<DirectorChart>& charts, bool rotate,
+                              std::vector<double>& node_inverse) const {
+  const int nn = mesh_.num_nodes();
+  if (u_ref.size() != num_dofs() || u.size() != num_dofs() || static_cast<int>(charts_ref.size()) != nn ||
+      static_cast<int>(charts.size()) != nn)
+    throw std::invalid_argument("Model::kept_matrix_basis: u and charts do not match the model");
+  // A rotation would mix constrained and free unknowns: only for unconstrained bodies (docs/theory.md §6.9).
+  if (rotate && (!dofs_.constrained_dofs().empty() || has_prescribed_motion())) rotate = false;
+  Eigen::Matrix3d R = Eigen::Matrix3d::Identity();
+  if (rotate) {  // least-squares rotation about the centroids (Kabsch): x − c ≈ R (x_ref − c_ref)
+    Vec3 c_ref = Vec3::Zero(), c = Vec3::Zero();
+    for (int i = 0; i < nn; ++i) {
+      c_ref += mesh_.X[static_cast<size_t>(i)] + u_ref.segment<3>(DofMap::dof(i, 0));
+      c += mesh_.X[static_cast<size_t>(i)] + u.segment<3>(DofMap::dof(i, 0));
+    }
+    c_ref /= nn;
+    c /= nn;
+    Eigen::Matrix3d H = Eigen::Matrix3d::Zero();
+    for (int i = 0; i < nn; ++i) {
+      const Vec3 a = mesh_.X[static_cast<size_t>(i)] + u_ref.segment<3>(DofMap::dof(i, 0)) - c_ref;
+      const Vec3 b = mesh_.X[static_cast<size_t>(i)] + u.segment<3>(DofMap::dof(i, 0)) - c;
+      H.noalias() += a * b.transpose();
+    }
+    const Eigen::JacobiSVD<Eigen::Matrix3d> svd(H, Eigen::ComputeFullU | Eigen::ComputeFullV);
+    const Vec3 sv = svd.singularValues();
+    if (!(sv[1] > 1e-8 * sv[0]))  // nodes (nearly) on a line: the rotation about it is not determined
+      throw std::domain_error("the nodes are too close to a line to fix the body's rotation");
+    Eigen::Matrix3d D = Eigen::Matrix3d::Identity();
+    D(2, 2) = (svd.matrixV() * svd.matrixU().transpose()).determinant() < 0.0 ? -1.0 : 1.0;
+    R = svd.matrixV() * D * svd.matrixU().transpose();
+  }
+  const bool rotated = !R.isIdentity(0.0);
+  node_inverse.assign(static_cast<size_t>(25 * nn), 0.0);
+  bool changed = false;
+  for (int i = 0; i < nn; ++i) {
+    double* B = node_inverse.data() + 25 * i;
+    for (int a = 0; a < 3; ++a)
+      for (int b = 0; b < 3; ++b) B[5 * a + b] = R(a, b);  // T_d⁻¹ = R
+    const DirectorChart& cr = charts_ref[static_cast<size_t>(i)];
+    const DirectorChart& ch = charts[static_cast<size_t>(i)];
+    const bool switched = cr.n != ch.n || cr.m != ch.m || cr.l != ch.l || cr.s != ch.s;
+    Eigen::Matrix2d Tq_inv = Eigen::Matrix2d::Identity();
+    if (rotated || switched) {
+      const Index k = DofMap::dof(i, 3);
+      if (switched && (dofs_.is_constrained(k) || dofs_.is_constrained(k + 1)))
+        throw std::domain_error("node " + std::to_string(i) + " switched the chart of constrained director unknowns");
+      // T_q = S_ref Rᵀ A1(q): rows n_ref, m_ref of Rᵀ A1.
+      const Eigen::Matrix<double, 3, 2> RA = R.transpose() * shelldyn::director_A1(u.segment<2>(k), ch);
+      Eigen::Matrix2d Tq;
+      Tq.row(0) = RA.row(cr.n);
+      Tq.row(1) = RA.row(cr.m);
+      const double det = Tq.determinant();
+      if (!(std::abs(det) > 1e-3))
+        throw std::domain_error("node " + std::to_string(i) + ": the director turned too far from the kept chart");
+      Tq_inv = Tq.inverse();
+    }
+    for (int a = 0; a < 2; ++a)
+      for (int b = 0; b < 2; ++b) B[5 * (3 + a) + 3 + b] = Tq_inv(a, b);
+    changed = changed || rotated || switched;
+  }
+  return changed;
 }
 
 // ---- em-exact (docs/theory/exact-energy-momentum.md) ------------------------------------------------------

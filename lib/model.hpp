@@ -155,6 +155,9 @@ class Model final : public SemiDiscreteSystem {
   // them (what rechart() does after a switch). Throws std::invalid_argument on a count mismatch.
   void adopt_charts(const std::vector<DirectorChart>& charts);
   double chart_margin(const State& s) const override;
+  bool kept_matrix_basis(const Eigen::VectorXd& u_ref, const std::vector<DirectorChart>& charts_ref,
+                         const Eigen::VectorXd& u, const std::vector<DirectorChart>& charts, bool rotate,
+                         std::vector<double>& node_inverse) const override;
 
  private:
   void gather(int e, const Eigen::VectorXd& global, CR9Shell::Vec45& ue) const;

@@ -83,6 +83,19 @@ class SemiDiscreteSystem {
   // |p_l| − max(|p_n|, |p_m|) (≥ 0 while the chart is the best one). Root functions of adaptive
   // integrators stop where this crosses zero. Systems without directors return +1.
   virtual double chart_margin(const State& s) const = 0;
+
+  // A kept iteration matrix seen from another configuration (docs/theory.md §6.9). The matrix was formed at
+  // (u_ref, charts_ref); the unknowns now are (u, charts). Fills, per node i, the inverse of the 5 × 5 block
+  // T_i of δu_ref = T δu as node_inverse[25 i ..] (row-major), and returns true when some T_i differs from the
+  // identity. `rotate`: T carries the rigid rotation R that best maps the nodes at u_ref onto those at u
+  // (T_d = Rᵀ, T_q = S_ref Rᵀ A1(q)); otherwise R = I and only nodes whose chart switched have T_i ≠ I.
+  // Throws std::domain_error when the change cannot be represented (the caller then refreshes the matrix).
+  // Systems without directors return false (no change).
+  virtual bool kept_matrix_basis(const Eigen::VectorXd& /*u_ref*/, const std::vector<DirectorChart>& /*charts_ref*/,
+                                 const Eigen::VectorXd& /*u*/, const std::vector<DirectorChart>& /*charts*/,
+                                 bool /*rotate*/, std::vector<double>& /*node_inverse*/) const {
+    return false;
+  }
 };
 
 }  // namespace shelldyn

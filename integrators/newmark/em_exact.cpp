@@ -46,6 +46,8 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
       throw std::invalid_argument("em-exact.refresh_cost must be >= 0 (a refresh's cost in iterations; 0 = off)");
     nopt_.refresh_contraction = s.get("refresh", nopt_.modified ? 0.03 : 0.0);
     nopt_.max_setup_calls = s.get("setup_every", nopt_.refresh_contraction > 0 ? 1000000 : 20);
+    // How a kept K̄ is carried to later configurations (docs/theory.md §6.9; kept_iteration_matrix.hpp).
+    kept_.set_basis(KeptIterationMatrix::parse_basis(s.get("kbar_basis", std::string("corotated")), std::string("em-exact")));
     // CHOLMOD's supernodal Cholesky as em-galpha (faster solves than Eigen's simplicial LDLᵀ, no hidden threads).
     nopt_.linear_solver = s.get("linear_solver", "cholmod");
     // Predictor (theory §5): u_n, or with modified Newton the trapezoidal extrapolation d_n + Δt v_n + Δt²/2 a_n,
@@ -281,7 +283,7 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
   bool step(State& s, double h, StepReport& rep, std::string* why, bool full_newton = false) {
     Model& sys = *model_;
     rep.chart_switches += sys.rechart(s, hysteresis_);  // between steps only; d, p, v, w unchanged
-    kept_.start_step(h, *newton_);  // K̄ depends on h
+    kept_.start_step(h, *newton_, sys, s);  // K̄ depends on h
     if (full_newton && !full_newton_) {
       NewtonOptions full = nopt_;
       full.modified = false;
@@ -334,7 +336,7 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
     };
     bool replayed = false;
     auto jacobian = [&](const double* up, SparseMatrix& J) {
-      if (!full_newton && kept_.replay(J)) {  // first setup after restore(): the saved K̄, not a new one
+      if (!full_newton && kept_.replay(J, newton)) {  // first setup after restore(): the saved K̄, not a new one
         // The uninterrupted run reuses this K̄ from an earlier step here: last_jacobian_iter stays 0.
         replayed = true;
         return;
@@ -349,7 +351,7 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
       const double cm = 2.0 / (h * h);
       for (size_t k = 0; k < J.values.size(); ++k) J.values[k] = cm * M_.values[k] + 0.5 * K_.values[k];
       apply_dirichlet(sys.dofs(), J, nullptr);
-      if (nopt_.modified && !full_newton) kept_.keep(J);  // for save()
+      if (nopt_.modified && !full_newton) kept_.keep(J, umid_, charts);  // for save()
     };
     double first_step = 0.0;  // scaled size of the first correction
     double prev_step = 0.0;   // scaled size of the previous correction (certify = predicted)

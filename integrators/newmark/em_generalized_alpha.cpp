@@ -67,6 +67,8 @@ class NewmarkFamily final : public Integrator {
     // refresh = 0 keeps the fixed count setup_every; refresh > 0 refreshes when θ exceeds it.
     nopt_.refresh_contraction = s.get("refresh", nopt_.modified ? 0.1 : 0.0);
     nopt_.max_setup_calls = s.get("setup_every", nopt_.refresh_contraction > 0 ? 1000000 : 20);
+    // How a kept K̄ is carried to later configurations (docs/theory.md §6.9; kept_iteration_matrix.hpp).
+    kept_.set_basis(KeptIterationMatrix::parse_basis(s.get("kbar_basis", std::string("corotated")), name_));
     // Predictor (§6.4 uses u_{n+1}^(0) = u_n): "newmark" starts from the constant-acceleration prediction
     // u_n + Δt v_n + Δt²/2 a_n, for which the Newmark relations give ü_{n+1}^(0) = a_n.
     const std::string predictor = s.get("predictor", nopt_.modified ? "newmark" : "none");
@@ -233,7 +235,7 @@ class NewmarkFamily final : public Integrator {
   // One step of size h from s (docs/theory.md §6.6). Returns false (s unchanged but for charts) on failure.
   bool step(SemiDiscreteSystem& sys, State& s, double h, StepReport& rep, std::string* why, bool full_newton = false) {
     rep.chart_switches += sys.rechart(s, hysteresis_);  // §2.3: between steps only
-    kept_.start_step(h, *newton_);  // K̄ depends on h (modified Newton)
+    kept_.start_step(h, *newton_, sys, s);  // K̄ depends on h (modified Newton)
     if (full_newton && !full_newton_) {
       NewtonOptions full = nopt_;
       full.modified = false;
@@ -298,7 +300,7 @@ class NewmarkFamily final : public Integrator {
     };
     bool replayed = false;
     auto jacobian = [&](const double* u, SparseMatrix& J) {
-      if (!full_newton && kept_.replay(J)) {  // first setup after restore(): the saved K̄, not a new one
+      if (!full_newton && kept_.replay(J, newton)) {  // first setup after restore(): the saved K̄, not a new one
         replayed = true;
         return;
       }
@@ -325,7 +327,7 @@ class NewmarkFamily final : public Integrator {
       for (size_t k = 0; k < J.values.size(); ++k) J.values[k] = du * M_.values[k] + (1 - af) * K_.values[k];
       sys.add_damping_matrix(cu, J);  // ∂(C u̇_mid)/∂u_{n+1} (docs/theory.md §8.5)
       apply_dirichlet(sys.dofs(), J, nullptr);
-      if (nopt_.modified && !full_newton) kept_.keep(J);  // for save()
+      if (nopt_.modified && !full_newton) kept_.keep(J, umid_, charts);  // for save()
     };
 
     Eigen::VectorXd u = un_;  // predictor u_{n+1}^(0) = u_n (§6.4)

@@ -57,6 +57,59 @@ void validate(const NewtonOptions& o) {
   if (!is_linear_solver_name(o.linear_solver)) make_linear_solver(o.linear_solver);  // throws with the valid names
 }
 
+// The linear solver seen through a change of unknowns (NewtonSolver::set_kept_basis_change): x = T⁻¹ A⁻¹ T⁻ᵀ b
+// with A the inner solver's factorized matrix. With no blocks the inner solve runs on b and x directly
+// (bitwise the inner solver's).
+class BasisChangeSolver final : public LinearSolver {
+ public:
+  BasisChangeSolver(std::unique_ptr<LinearSolver> inner, const std::vector<NewtonSolver::BasisBlock>* blocks)
+      : inner_(std::move(inner)), blocks_(blocks) {}
+  std::string name() const override { return inner_->name(); }
+  void analyze(const CscView& A) override {
+    inner_->analyze(A);
+    stats_ = inner_->stats();
+  }
+  void factorize(const CscView& A) override {
+    inner_->factorize(A);
+    stats_ = inner_->stats();
+  }
+  void solve(const double* b, double* x) const override {
+    if (blocks_->empty()) {
+      inner_->solve(b, x);
+    } else {
+      work_.assign(b, b + n_);
+      for (const auto& bl : *blocks_) {  // T⁻ᵀ b
+        double y[3];
+        for (int j = 0; j < bl.size; ++j) {
+          y[j] = 0.0;
+          for (int i = 0; i < bl.size; ++i) y[j] += bl.inverse[3 * i + j] * work_[static_cast<size_t>(bl.first + i)];
+        }
+        for (int j = 0; j < bl.size; ++j) work_[static_cast<size_t>(bl.first + j)] = y[j];
+      }
+      inner_->solve(work_.data(), x);
+      for (const auto& bl : *blocks_) {  // T⁻¹ x
+        double y[3];
+        for (int i = 0; i < bl.size; ++i) {
+          y[i] = 0.0;
+          for (int j = 0; j < bl.size; ++j) y[i] += bl.inverse[3 * i + j] * x[bl.first + j];
+        }
+        for (int i = 0; i < bl.size; ++i) x[bl.first + i] = y[i];
+      }
+    }
+    stats_ = inner_->stats();
+  }
+  bool factorized() const override { return inner_->factorized(); }
+  long negative_pivots() const override { return inner_->negative_pivots(); }
+  bool set_single_precision_solves(bool on) override { return inner_->set_single_precision_solves(on); }
+  void set_size(Index n) { n_ = n; }
+
+ private:
+  std::unique_ptr<LinearSolver> inner_;
+  const std::vector<NewtonSolver::BasisBlock>* blocks_;
+  Index n_ = 0;
+  mutable std::vector<double> work_;
+};
+
 }  // namespace
 
 struct NewtonSolver::Impl {
@@ -87,6 +140,7 @@ struct NewtonSolver::Impl {
   bool have_jacobian = false, force_setup = false;
   int since_setup = 0;
   int resume_since_setup = -1;  // checkpoint restart: since_setup after the next setup (-1: 0)
+  std::vector<BasisBlock> basis;  // set_kept_basis_change(); cleared at every Jacobian setup
 
   ~Impl() {
     if (kin) KINFree(&kin);
@@ -140,6 +194,7 @@ struct NewtonSolver::Impl {
     auto* s = static_cast<Impl*>(user_data);
     try {
       ++s->jacobian_evals;
+      s->basis.clear();  // the new matrix is formed in the current unknowns (the callback may set a change again)
       (*s->jacobian)(N_VGetArrayPointer(uu), s->Jwork);
       if (s->Jwork.pattern != s->pattern || static_cast<Index>(s->Jwork.values.size()) != s->pattern->nnz())
         throw std::invalid_argument(
@@ -183,7 +238,9 @@ NewtonSolver::NewtonSolver(std::shared_ptr<const SparsePattern> pattern, NewtonO
       throw std::invalid_argument("NewtonSolver: linear_solver '" + s.opt.linear_solver +
                                   "' has no single-precision solves (docs/dependencies.md §5.5); use cholmod, "
                                   "or double solves");
-    s.LS.reset(make_sun_linear_solver(s.ctx, std::move(ls)));
+    auto wrapped = std::make_unique<BasisChangeSolver>(std::move(ls), &s.basis);
+    wrapped->set_size(s.n);
+    s.LS.reset(make_sun_linear_solver(s.ctx, std::move(wrapped)));
   }
   s.Jwork.pattern = pattern;
   s.Jwork.values.assign(pattern->nnz(), 0.0);
@@ -221,6 +278,30 @@ int NewtonSolver::iterations_since_setup() const {
   return s.have_jacobian && !s.force_setup && s.since_setup < s.opt.max_setup_calls ? s.since_setup : -1;
 }
 void NewtonSolver::resume_after_setup(int k) { impl_->resume_since_setup = k; }
+void NewtonSolver::set_kept_basis_change(std::vector<BasisBlock> blocks) {
+  if (blocks.empty()) {
+    impl_->basis.clear();
+    return;
+  }
+  std::vector<char> used(static_cast<size_t>(impl_->n), 0);
+  for (const BasisBlock& b : blocks) {
+    if (b.size < 1 || b.size > 3 || b.first < 0 || b.first + b.size > impl_->n)
+      throw std::invalid_argument("NewtonSolver::set_kept_basis_change: block at " + std::to_string(b.first) +
+                                  " of size " + std::to_string(b.size) + " is outside the " +
+                                  std::to_string(impl_->n) + " unknowns");
+    for (int i = 0; i < b.size; ++i) {
+      if (used[static_cast<size_t>(b.first + i)]++)
+        throw std::invalid_argument("NewtonSolver::set_kept_basis_change: blocks overlap at unknown " +
+                                    std::to_string(b.first + i));
+      for (int j = 0; j < b.size; ++j)
+        if (!std::isfinite(b.inverse[3 * i + j]))
+          throw std::invalid_argument("NewtonSolver::set_kept_basis_change: non-finite entry in the block at " +
+                                      std::to_string(b.first));
+    }
+  }
+  impl_->basis = std::move(blocks);
+}
+const std::vector<NewtonSolver::BasisBlock>& NewtonSolver::kept_basis_change() const { return impl_->basis; }
 
 NewtonSolver::Result NewtonSolver::solve(double* u, const Residual& residual, const Jacobian& jacobian,
                                          const double* fscale, const double* uscale,

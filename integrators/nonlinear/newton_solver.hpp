@@ -59,6 +59,7 @@
 #include <string>
 #include <type_traits>
 #include <utility>
+#include <vector>
 
 namespace shelldyn {
 
@@ -181,6 +182,20 @@ class NewtonSolver {
   // replays the saved matrix) refreshes at the same iterations as the solver that was saved.
   int iterations_since_setup() const;
   void resume_after_setup(int k);
+
+  // Modified Newton across a change of unknowns (docs/theory.md §6.9): the kept Jacobian J₀ was formed in
+  // unknowns u₀, and the current unknowns u relate to them by δu₀ = T δu with T block diagonal. The solves
+  // then apply T⁻¹ J₀⁻¹ T⁻ᵀ, i.e. the kept matrix seen in the current unknowns, Tᵀ J₀ T, without a new
+  // factorization. Each block gives T⁻¹ on the `size` (1..3) consecutive unknowns from `first`; blocks must
+  // not overlap; unknowns in no block keep T = I. The blocks replace earlier ones; the next Jacobian setup
+  // clears them (a new matrix is formed in the current unknowns), and so does an empty vector.
+  struct BasisBlock {
+    Index first = 0;
+    int size = 0;
+    double inverse[9] = {};  // T⁻¹, row-major size × size in the top-left
+  };
+  void set_kept_basis_change(std::vector<BasisBlock> blocks);
+  const std::vector<BasisBlock>& kept_basis_change() const;  // in use (checkpoints save it)
 
   const NewtonOptions& options() const;
   const LinearSolver& linear_solver() const;  // stats(): analyses stay at 1 for a fixed pattern

@@ -4,6 +4,7 @@
 // the fold (λ ≈ 6.8).
 #include "integrators/nonlinear/newton_solver.hpp"
 
+#include <Eigen/Dense>
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -384,6 +385,84 @@ TEST(NewtonSolver, HookCanAcceptAndInitialSolutionIsRecognised) {
   EXPECT_EQ(r.iterations, 0);
   EXPECT_EQ(r.stop_reason, NewtonSolver::StopReason::initial_guess);
   EXPECT_EQ(r.jacobian_evals, 0);
+}
+
+TEST(NewtonSolver, KeptBasisChangeSolvesInTheNewUnknownsWithoutAFactorization) {
+  // docs/theory.md §6.9: a kept factorization of A, seen through δu₀ = T δu, is the matrix Tᵀ A T. For the
+  // linear problem F(u) = Tᵀ A T u − Tᵀ c the kept factorization with the change installed is its exact
+  // Jacobian: one iteration and no setup; without the change the same kept A needs many iterations.
+  const Bratu b(4, 1.0);
+  const Index n = b.n();
+  SparseMatrix Am{b.pattern, {}};
+  Am.values.assign(b.pattern->nnz(), 0.0);
+  const std::vector<double> zero(static_cast<size_t>(n), 0.0);
+  b.jacobian(zero.data(), Am);
+  Eigen::MatrixXd A = Eigen::MatrixXd::Zero(n, n);
+  for (Index c = 0; c < n; ++c)
+    for (Index p = b.pattern->colptr[c]; p < b.pattern->colptr[c + 1]; ++p) A(b.pattern->rowind[p], c) = Am.values[p];
+  // T block diagonal: a rotation-like 3 × 3 block at 0, a 2 × 2 block at 5, identity elsewhere.
+  Eigen::MatrixXd T = Eigen::MatrixXd::Identity(n, n);
+  T.block<3, 3>(0, 0) << 0.8, -0.6, 0.0, 0.6, 0.8, 0.0, 0.0, 0.0, 1.0;
+  T.block<2, 2>(5, 5) << 1.2, 0.3, -0.1, 0.9;
+  const Eigen::MatrixXd Ti = T.inverse();
+  std::vector<NewtonSolver::BasisBlock> blocks(2);
+  blocks[0].first = 0;
+  blocks[0].size = 3;
+  blocks[1].first = 5;
+  blocks[1].size = 2;
+  for (const int k : {0, 1})
+    for (int r = 0; r < blocks[k].size; ++r)
+      for (int c = 0; c < blocks[k].size; ++c) blocks[k].inverse[3 * r + c] = Ti(blocks[k].first + r, blocks[k].first + c);
+  Eigen::VectorXd c = Eigen::VectorXd::LinSpaced(n, 1.0, 2.0);
+  const Eigen::MatrixXd TAT = T.transpose() * A * T;
+  const Eigen::VectorXd rhs = T.transpose() * c;
+  NewtonSolver::Residual F1 = [&](const double* u, double* f) {
+    Eigen::Map<Eigen::VectorXd>(f, n) = A * Eigen::Map<const Eigen::VectorXd>(u, n) - c;
+  };
+  NewtonSolver::Residual F2 = [&](const double* u, double* f) {
+    Eigen::Map<Eigen::VectorXd>(f, n) = TAT * Eigen::Map<const Eigen::VectorXd>(u, n) - rhs;
+  };
+  NewtonSolver::Jacobian J = [&](const double*, SparseMatrix& Jm) { Jm.values = Am.values; };
+  auto run = [&](bool change, NewtonSolver::Result& r1, NewtonSolver::Result& r2, Eigen::VectorXd& u2) {
+    NewtonOptions o;
+    o.modified = true;
+    o.max_setup_calls = 1000;
+    o.max_iters = 200;
+    o.fnorm_tol = 1e-9;
+    o.step_tol = 0.0;
+    NewtonSolver s(b.pattern, o);
+    std::vector<double> u(static_cast<size_t>(n), 0.0);
+    r1 = s.solve(u.data(), F1, J);  // forms and keeps A
+    if (change) s.set_kept_basis_change(blocks);
+    std::fill(u.begin(), u.end(), 0.0);
+    r2 = s.solve(u.data(), F2, J);
+    u2 = Eigen::Map<Eigen::VectorXd>(u.data(), n);
+    EXPECT_EQ(s.kept_basis_change().size(), change ? 2u : 0u);
+    s.invalidate_jacobian();  // a new setup forms the matrix in the current unknowns: the change is cleared
+    r1 = s.solve(u.data(), F1, J);
+    EXPECT_TRUE(s.kept_basis_change().empty());
+  };
+  NewtonSolver::Result r1, r2, q1, q2;
+  Eigen::VectorXd u2, v2;
+  run(true, r1, r2, u2);
+  ASSERT_TRUE(r2.converged) << r2.message;
+  EXPECT_EQ(r2.jacobian_evals, 0);
+  EXPECT_EQ(r2.iterations, 1);
+  EXPECT_LE((TAT * u2 - rhs).cwiseAbs().maxCoeff(), 1e-9);
+  run(false, q1, q2, v2);
+  EXPECT_EQ(q2.jacobian_evals, 0);
+  EXPECT_GT(q2.iterations, 5) << "the kept A without the change should be a poor model of Tᵀ A T";
+
+  NewtonSolver s(b.pattern);
+  auto bad = blocks;
+  bad[1].first = 2;  // overlaps the 3 × 3 block
+  EXPECT_THROW(s.set_kept_basis_change(bad), std::invalid_argument);
+  bad = blocks;
+  bad[1].first = n - 1;  // runs past the end
+  EXPECT_THROW(s.set_kept_basis_change(bad), std::invalid_argument);
+  bad = blocks;
+  bad[0].inverse[4] = std::nan("");
+  EXPECT_THROW(s.set_kept_basis_change(bad), std::invalid_argument);
 }
 
 TEST(NewtonSolver, RejectsBadOptions) {

@@ -10,6 +10,7 @@
 #include <omp.h>
 
 #include <Eigen/Dense>
+#include <Eigen/Geometry>
 #include <cmath>
 
 namespace shelldyn {
@@ -102,6 +103,66 @@ TEST(Model, RechartKeepsDirectorsRatesAndKineticEnergy) {
     EXPECT_LT((model.director(s, i) - p0[static_cast<size_t>(i)]).norm(), 1e-15);
   }
   EXPECT_NEAR(model.invariants(s).kinetic, K0, 1e-15 * K0);
+}
+
+// docs/theory.md §6.9: seen through δu_ref = T δu, the tangent and the mass of a stress-free body moved
+// rigidly (a finite rotation that also switches director charts) are Tᵀ K_ref T and Tᵀ M_ref T, with R the
+// rotation that kept_matrix_basis() recovers from the nodes.
+TEST(Model, KeptMatrixBasisCarriesTangentAndMassThroughARigidRotationAndChartSwitches) {
+  Model model = plate_model(2, 1);
+  const State ref = model.initial_state();  // flat, stress-free
+  const Eigen::Matrix3d Q = Eigen::AngleAxisd(1.2, Vec3(1.0, 0.3, 0.2).normalized()).toRotationMatrix();
+  const Vec3 shift(0.4, -1.0, 2.5);
+  State rot = ref;
+  const int nn = model.mesh().num_nodes();
+  for (int i = 0; i < nn; ++i) {
+    const Vec3& X = model.mesh().X[static_cast<size_t>(i)];
+    rot.u.segment<3>(DofMap::dof(i, 0)) = Q * X + shift - X;
+    const Vec3 p = Q * model.director(ref, i);
+    rot.u.segment<2>(DofMap::dof(i, 3)) = chart_coordinates(p, rot.charts[static_cast<size_t>(i)]);
+  }
+  ASSERT_EQ(model.rechart(rot), nn) << "the rotation should switch every chart";
+  std::vector<double> inv;
+  ASSERT_TRUE(model.kept_matrix_basis(ref.u, ref.charts, rot.u, rot.charts, true, inv));
+  ASSERT_EQ(inv.size(), static_cast<size_t>(25 * nn));
+  const Index n = model.num_dofs();
+  Eigen::MatrixXd Tinv = Eigen::MatrixXd::Zero(n, n);
+  for (int i = 0; i < nn; ++i)
+    for (int a = 0; a < 5; ++a)
+      for (int b = 0; b < 5; ++b) Tinv(5 * i + a, 5 * i + b) = inv[static_cast<size_t>(25 * i + 5 * a + b)];
+  // The translation blocks are R = Q.
+  for (int i = 0; i < nn; ++i) EXPECT_LT((Tinv.block<3, 3>(5 * i, 5 * i) - Q).norm(), 1e-12) << "node " << i;
+  const Eigen::MatrixXd T = Tinv.inverse();
+  SparseMatrix K0{model.pattern(), {}}, K1{model.pattern(), {}}, M0{model.pattern(), {}}, M1{model.pattern(), {}};
+  for (SparseMatrix* A : {&K0, &K1, &M0, &M1}) A->values.assign(model.pattern()->nnz(), 0.0);
+  Eigen::VectorXd f(n);
+  model.internal(ref.u, ref.charts, f.data(), &K0);
+  model.internal(rot.u, rot.charts, f.data(), &K1);
+  model.mass(ref.u, ref.charts, M0);
+  model.mass(rot.u, rot.charts, M1);
+  const Eigen::MatrixXd K0d = dense(K0), K1d = dense(K1), M0d = dense(M0), M1d = dense(M1);
+  EXPECT_LT((T.transpose() * K0d * T - K1d).cwiseAbs().maxCoeff(), 1e-9 * K1d.cwiseAbs().maxCoeff());
+  EXPECT_LT((T.transpose() * M0d * T - M1d).cwiseAbs().maxCoeff(), 1e-12 * M1d.cwiseAbs().maxCoeff());
+  // Without the change the kept matrices are far off (what the test would see if T were ignored).
+  EXPECT_GT((K0d - K1d).cwiseAbs().maxCoeff(), 0.1 * K1d.cwiseAbs().maxCoeff());
+
+  // rotate = false: R = I, only the chart switches are carried.
+  ASSERT_TRUE(model.kept_matrix_basis(ref.u, ref.charts, rot.u, rot.charts, false, inv));
+  for (int a = 0; a < 3; ++a)
+    for (int b = 0; b < 3; ++b) EXPECT_EQ(inv[static_cast<size_t>(5 * a + b)], a == b ? 1.0 : 0.0);
+  // Nothing changed: identity, and false.
+  EXPECT_FALSE(model.kept_matrix_basis(ref.u, ref.charts, ref.u, ref.charts, false, inv));
+
+  // A constrained body is not rotated; a switched chart of a constrained director cannot be carried.
+  Mesh mesh = make_rectangle(2.0, 1.0, 2, 1, -1.0, -0.5);
+  auto normals = initial_normals(mesh);
+  DofMap dofs(mesh.num_nodes());
+  dofs.fix(0, Fix::Director);
+  Model clamped(std::move(mesh), std::move(normals), kPlate, std::move(dofs), {});
+  EXPECT_THROW(clamped.kept_matrix_basis(ref.u, ref.charts, rot.u, rot.charts, true, inv), std::domain_error);
+  State moved = ref;
+  moved.u.segment<3>(0) += Vec3(0.1, 0.0, 0.0);  // translations only: R stays I although rotate = true
+  EXPECT_FALSE(clamped.kept_matrix_basis(ref.u, ref.charts, moved.u, moved.charts, true, inv));
 }
 
 TEST(Model, ResultsDoNotDependOnTheThreadCount) {
