@@ -283,7 +283,7 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
   bool step(State& s, double h, StepReport& rep, std::string* why, bool full_newton = false) {
     Model& sys = *model_;
     rep.chart_switches += sys.rechart(s, hysteresis_);  // between steps only; d, p, v, w unchanged
-    kept_.start_step(h, *newton_, sys, s);  // K̄ depends on h
+    kept_.start_step(h, *newton_);  // K̄ depends on h
     if (full_newton && !full_newton_) {
       NewtonOptions full = nopt_;
       full.modified = false;
@@ -335,8 +335,14 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
       last_r_ = r;
     };
     bool replayed = false;
+    // The kept K̄ seen from each iterate's midpoint configuration (docs/theory.md §6.9; modified Newton only).
+    const NewtonSolver::BasisProvider basis =
+        full_newton ? NewtonSolver::BasisProvider{}
+                    : kept_.provider(sys, charts, [this, n](const double* u, Eigen::VectorXd& x) {
+                        x = 0.5 * (Eigen::Map<const Eigen::VectorXd>(u, n) + un_);
+                      });
     auto jacobian = [&](const double* up, SparseMatrix& J) {
-      if (!full_newton && kept_.replay(J, newton)) {  // first setup after restore(): the saved K̄, not a new one
+      if (!full_newton && kept_.replay(J, newton, basis, up)) {  // first setup after restore(): the saved K̄, not a new one
         // The uninterrupted run reuses this K̄ from an earlier step here: last_jacobian_iter stays 0.
         replayed = true;
         return;
@@ -413,7 +419,7 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
     last_r_.setZero(n);
     // Scale of the unknowns 1/max(1, |u_n,i|): the solver's round-off guard of the contraction test is relative.
     uscale_ = (1.0 / un_.array().abs().max(1.0)).matrix();
-    const NewtonSolver::Result r = newton.solve(u.data(), residual, jacobian, nullptr, uscale_.data(), hook);
+    const NewtonSolver::Result r = newton.solve(u.data(), residual, jacobian, nullptr, uscale_.data(), hook, basis);
     if (full_newton) newton_->invalidate_jacobian();
     // The renewal rule (theory §5.5), modified Newton only: after a step that kept K̄, refresh it for the next
     // step when this step's iterations exceed the average since the last refresh, (refresh_cost + Σ it)/steps.

@@ -235,7 +235,7 @@ class NewmarkFamily final : public Integrator {
   // One step of size h from s (docs/theory.md §6.6). Returns false (s unchanged but for charts) on failure.
   bool step(SemiDiscreteSystem& sys, State& s, double h, StepReport& rep, std::string* why, bool full_newton = false) {
     rep.chart_switches += sys.rechart(s, hysteresis_);  // §2.3: between steps only
-    kept_.start_step(h, *newton_, sys, s);  // K̄ depends on h (modified Newton)
+    kept_.start_step(h, *newton_);  // K̄ depends on h (modified Newton)
     if (full_newton && !full_newton_) {
       NewtonOptions full = nopt_;
       full.modified = false;
@@ -299,8 +299,14 @@ class NewmarkFamily final : public Integrator {
       if (!rr.allFinite()) throw std::runtime_error("non-finite residual");
     };
     bool replayed = false;
+    // The kept K̄ seen from each iterate's midpoint configuration (docs/theory.md §6.9; modified Newton only).
+    const NewtonSolver::BasisProvider basis =
+        full_newton ? NewtonSolver::BasisProvider{}
+                    : kept_.provider(sys, charts, [this, n, af](const double* u, Eigen::VectorXd& x) {
+                        x = (1 - af) * Eigen::Map<const Eigen::VectorXd>(u, n) + af * un_;
+                      });
     auto jacobian = [&](const double* u, SparseMatrix& J) {
-      if (!full_newton && kept_.replay(J, newton)) {  // first setup after restore(): the saved K̄, not a new one
+      if (!full_newton && kept_.replay(J, newton, basis, u)) {  // first setup after restore(): the saved K̄, not a new one
         replayed = true;
         return;
       }
@@ -356,7 +362,7 @@ class NewmarkFamily final : public Integrator {
         if (!newton.options().modified || step_refresh_) return false;
         return (d.array().abs() * uscale_.array()).maxCoeff() <= step_tol_;
       };
-    const NewtonSolver::Result r = newton.solve(u.data(), residual, jacobian, nullptr, uscale_.data(), hook);
+    const NewtonSolver::Result r = newton.solve(u.data(), residual, jacobian, nullptr, uscale_.data(), hook, basis);
     if (full_newton) newton_->invalidate_jacobian();  // the modified solver's K̄ is stale now
     rep.nonlinear_iterations += r.iterations;
     // A replayed K̄ (restore()) is the uninterrupted run's matrix, not a new setup: not counted.

@@ -32,35 +32,49 @@ class KeptIterationMatrix {
   }
   void set_basis(Basis b) { basis_ = b; }
 
-  // At the start of every step (after the charts were updated): a new h makes the kept K̄ useless. Steps that
-  // land on an output time differ from Δt in the last bits (t_out − t); that is no reason to throw a
-  // factorization away. With kbar_basis ≠ fixed, the change of unknowns from where K̄ was formed to s.
-  void start_step(double h, NewtonSolver& newton, const SemiDiscreteSystem& sys, const State& s) {
+  // At the start of every step: a new h makes the kept K̄ useless. Steps that land on an output time differ from
+  // Δt in the last bits (t_out − t); that is no reason to throw a factorization away.
+  void start_step(double h, NewtonSolver& newton) {
     if (std::abs(h - last_h_) > 1e-8 * h) {
       newton.invalidate_jacobian();
       if (replay_) newton.resume_after_setup(0);  // a saved K̄ for another h is of no use
       replay_ = false;
     }
     last_h_ = h;
-    blocks_.clear();
-    if (basis_ == Basis::fixed || u_ref_.size() == 0) return;
-    try {
-      if (sys.kept_matrix_basis(u_ref_, charts_ref_, s.u, s.charts, basis_ == Basis::corotated, node_inverse_))
-        make_blocks();
-    } catch (const std::domain_error&) {  // not representable: form a new K̄
-      newton.invalidate_jacobian();
-      blocks_.clear();
-    }
-    newton.set_kept_basis_change(blocks_);
   }
 
-  // In the modified solver's Jacobian callback: the first setup after restore() takes the saved K̄ (same
-  // values, hence the same factorization as the uninterrupted run) instead of a new one; returns true then.
-  bool replay(SparseMatrix& J, NewtonSolver& newton) {
+  // The NewtonSolver::BasisProvider of a step (kbar_basis ≠ fixed; empty otherwise): the change of unknowns
+  // from where K̄ was formed to the configuration mid(u_k) of the iterate (the midpoint K̄ is formed at), in the
+  // step's charts. The references must outlive the solve.
+  template <class Mid>
+  NewtonSolver::BasisProvider provider(const SemiDiscreteSystem& sys, const std::vector<DirectorChart>& charts, Mid mid) {
+    if (basis_ == Basis::fixed) return {};
+    return [this, &sys, &charts, mid](const double* u, std::vector<NewtonSolver::BasisBlock>& blocks) {
+      blocks.clear();
+      if (u_ref_.size() == 0) return;
+      mid(u, x_);
+      if (sys.kept_matrix_basis(u_ref_, charts_ref_, x_, charts, basis_ == Basis::corotated, node_inverse_))
+        make_blocks(blocks);
+    };
+  }
+
+  // In the modified solver's Jacobian callback at the iterate u: the first setup after restore() takes the saved
+  // K̄ (same values, hence the same factorization as the uninterrupted run) instead of a new one, seen through the
+  // change the uninterrupted run used at this iterate; returns true then.
+  bool replay(SparseMatrix& J, NewtonSolver& newton, const NewtonSolver::BasisProvider& basis, const double* u) {
     if (!replay_) return false;
     J.values = kbar_;
     replay_ = false;
-    newton.set_kept_basis_change(blocks_);  // the setup cleared it; the saved K̄ is in the saved reference's unknowns
+    std::vector<NewtonSolver::BasisBlock> blocks;
+    if (basis) {
+      try {
+        basis(u, blocks);
+      } catch (const std::domain_error&) {  // the uninterrupted run formed a new K̄ here: so must this one
+        newton.resume_after_setup(0);
+        return false;
+      }
+    }
+    newton.set_kept_basis_change(std::move(blocks));
     return true;
   }
   // In the modified solver's Jacobian callback after a new K̄ was formed at the configuration (u, charts)
@@ -116,7 +130,7 @@ class KeptIterationMatrix {
  private:
   // The node blocks of T⁻¹ (25 numbers per node, row-major 5 × 5 with the 3 × 3 and 2 × 2 blocks) as
   // NewtonSolver blocks, identity blocks left out.
-  void make_blocks() {
+  void make_blocks(std::vector<NewtonSolver::BasisBlock>& blocks) const {
     const size_t nn = node_inverse_.size() / 25;
     for (size_t i = 0; i < nn; ++i) {
       const double* B = node_inverse_.data() + 25 * i;
@@ -132,7 +146,7 @@ class KeptIterationMatrix {
             b.inverse[3 * r + c] = B[5 * (off + r) + off + c];
             identity = identity && b.inverse[3 * r + c] == (r == c ? 1.0 : 0.0);
           }
-        if (!identity) blocks_.push_back(b);
+        if (!identity) blocks.push_back(b);
       }
     }
   }
@@ -140,8 +154,8 @@ class KeptIterationMatrix {
   Basis basis_ = Basis::fixed;
   Eigen::VectorXd u_ref_;                  // configuration K̄ was formed at (kbar_basis ≠ fixed)
   std::vector<DirectorChart> charts_ref_;  // its charts
+  Eigen::VectorXd x_;                      // the iterate's midpoint configuration (provider())
   std::vector<double> node_inverse_;
-  std::vector<NewtonSolver::BasisBlock> blocks_;  // this step's change of unknowns
   std::vector<double> kbar_;  // the modified solver's last K̄
   bool replay_ = false;       // restore(): the next setup of the modified solver uses kbar_
   double last_h_ = 0.0;

@@ -141,6 +141,7 @@ struct NewtonSolver::Impl {
   int since_setup = 0;
   int resume_since_setup = -1;  // checkpoint restart: since_setup after the next setup (-1: 0)
   std::vector<BasisBlock> basis;  // set_kept_basis_change(); cleared at every Jacobian setup
+  std::vector<BasisBlock> basis_work;  // filled by solve()'s BasisProvider
 
   ~Impl() {
     if (kin) KINFree(&kin);
@@ -305,7 +306,7 @@ const std::vector<NewtonSolver::BasisBlock>& NewtonSolver::kept_basis_change() c
 
 NewtonSolver::Result NewtonSolver::solve(double* u, const Residual& residual, const Jacobian& jacobian,
                                          const double* fscale, const double* uscale,
-                                         const IterationHook& hook) {
+                                         const IterationHook& hook, const BasisProvider& basis) {
   Impl& s = *impl_;
   const NewtonOptions& o = s.opt;
   if (u == nullptr) throw std::invalid_argument("NewtonSolver::solve: u is null");
@@ -408,8 +409,19 @@ NewtonSolver::Result NewtonSolver::solve(double* u, const Residual& residual, co
   };
 
   while (k < o.max_iters) {
-    const bool need_setup = !o.modified || !s.have_jacobian || s.force_setup ||
-                            s.since_setup >= o.max_setup_calls;
+    bool need_setup = !o.modified || !s.have_jacobian || s.force_setup || s.since_setup >= o.max_setup_calls;
+    if (basis && !need_setup) {  // the kept Jacobian seen from u_k (docs/theory.md §6.9)
+      try {
+        basis(uu, s.basis_work);
+        set_kept_basis_change(s.basis_work);
+      } catch (const std::domain_error&) {
+        s.basis.clear();
+        s.force_setup = need_setup = true;
+      } catch (...) {
+        s.cb_error.capture("basis provider");
+        return finish(false, StopReason::failure, 0, s.cb_error.message());
+      }
+    }
     check_kin(KINSetNoInitSetup(s.kin, need_setup ? SUNFALSE : SUNTRUE), "KINSetNoInitSetup");
     std::copy(uu, uu + n, s.u_prev.begin());
     const int jac0 = s.jacobian_evals;

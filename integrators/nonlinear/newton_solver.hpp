@@ -144,6 +144,25 @@ class NewtonSolver {
 
   enum class StopReason { none, fnorm, step, initial_guess, energy, hook, failure, max_iters };
 
+  // Modified Newton across a change of unknowns (docs/theory.md §6.9): the kept Jacobian J₀ was formed in
+  // unknowns u₀, and the current unknowns u relate to them by δu₀ = T δu with T block diagonal. The solves
+  // then apply T⁻¹ J₀⁻¹ T⁻ᵀ, i.e. the kept matrix seen in the current unknowns, Tᵀ J₀ T, without a new
+  // factorization. Each block gives T⁻¹ on the `size` (1..3) consecutive unknowns from `first`; blocks must
+  // not overlap; unknowns in no block keep T = I. set_kept_basis_change() replaces the blocks; every Jacobian
+  // setup clears them (a new matrix is formed in the current unknowns; the Jacobian callback may set them
+  // again), and so does an empty vector.
+  struct BasisBlock {
+    Index first = 0;
+    int size = 0;
+    double inverse[9] = {};  // T⁻¹, row-major size × size in the top-left
+  };
+  void set_kept_basis_change(std::vector<BasisBlock> blocks);
+  const std::vector<BasisBlock>& kept_basis_change() const;  // in use
+  // Optional argument of solve(): called with the iterate u_k before every iteration that reuses the kept
+  // Jacobian, it fills the blocks for that iteration (empty: none), or throws std::domain_error when the change
+  // cannot be represented, which makes that iteration form a new Jacobian instead.
+  using BasisProvider = std::function<void(const double* u, std::vector<BasisBlock>& blocks)>;
+
   struct Result {
     bool converged = false;
     int iterations = 0;      // KINSOL nonlinear iterations in this solve()
@@ -170,7 +189,7 @@ class NewtonSolver {
   // optional positive scaling vectors (length n), default all ones.
   Result solve(double* u, const Residual& residual, const Jacobian& jacobian,
                const double* fscale = nullptr, const double* uscale = nullptr,
-               const IterationHook& hook = {});
+               const IterationHook& hook = {}, const BasisProvider& basis = {});
 
   // Forces a Jacobian refresh at the next iteration (modified Newton: call it when the iteration
   // matrix changes for reasons the solver cannot see, e.g. a new time step size in K̄).
@@ -183,19 +202,6 @@ class NewtonSolver {
   int iterations_since_setup() const;
   void resume_after_setup(int k);
 
-  // Modified Newton across a change of unknowns (docs/theory.md §6.9): the kept Jacobian J₀ was formed in
-  // unknowns u₀, and the current unknowns u relate to them by δu₀ = T δu with T block diagonal. The solves
-  // then apply T⁻¹ J₀⁻¹ T⁻ᵀ, i.e. the kept matrix seen in the current unknowns, Tᵀ J₀ T, without a new
-  // factorization. Each block gives T⁻¹ on the `size` (1..3) consecutive unknowns from `first`; blocks must
-  // not overlap; unknowns in no block keep T = I. The blocks replace earlier ones; the next Jacobian setup
-  // clears them (a new matrix is formed in the current unknowns), and so does an empty vector.
-  struct BasisBlock {
-    Index first = 0;
-    int size = 0;
-    double inverse[9] = {};  // T⁻¹, row-major size × size in the top-left
-  };
-  void set_kept_basis_change(std::vector<BasisBlock> blocks);
-  const std::vector<BasisBlock>& kept_basis_change() const;  // in use (checkpoints save it)
 
   const NewtonOptions& options() const;
   const LinearSolver& linear_solver() const;  // stats(): analyses stay at 1 for a fixed pattern
