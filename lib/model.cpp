@@ -438,6 +438,9 @@ bool Model::kept_matrix_basis(const Eigen::VectorXd& u_ref, const std::vector<Di
     Eigen::Matrix3d D = Eigen::Matrix3d::Identity();
     D(2, 2) = (svd.matrixV() * svd.matrixU().transpose()).determinant() < 0.0 ? -1.0 : 1.0;
     R = svd.matrixV() * D * svd.matrixU().transpose();
+    // A body that does not turn (the pinched hemisphere's self-equilibrated loads) gets an R that differs from I
+    // by round-off only: keep I, so that its solves stay exactly those of the kept matrix.
+    if ((R - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff() <= 1e-12) R.setIdentity();
   }
   const bool rotated = !R.isIdentity(0.0);
   node_inverse.assign(static_cast<size_t>(25 * nn), 0.0);

@@ -58,7 +58,9 @@ class NewmarkFamily final : public Integrator {
     // by 2-3x on the flying plate at the same iteration count, but it diverges when stiff elements turn
     // fast as rigid bodies (the rotated elastic stiffness leaks into the soft rigid-body directions of a
     // stale K̄: the spinning plate of docs/benchmarks.md §6 fails at its first step). So a step that fails under
-    // modified Newton is retried with full Newton before any step cutting.
+    // modified Newton is retried with full Newton before any step cutting. (kbar_basis = corotated, below, carries
+    // K̄ through the rotation and removes most of that leak: a stiff plate at 30 rad/s falls back in 48 instead of
+    // 92 of 100 steps, test EmGeneralizedAlpha.KeptKbarFollowsTheBodysRotation.)
     const std::string newton = s.get("newton", "full");
     if (newton != "full" && newton != "modified")
       throw std::invalid_argument(name_ + ".newton: '" + newton + "' (use full or modified)");
