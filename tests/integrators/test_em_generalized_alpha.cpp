@@ -286,6 +286,8 @@ TEST(EmGeneralizedAlpha, RejectsBadSettings) {
   EXPECT_THROW(make("em-galpha", 0.01, {{"xi", "-0.1"}}), std::invalid_argument);
   EXPECT_THROW(make("em-galpha", 0.01, {{"newton", "quasi"}}), std::invalid_argument);
   EXPECT_THROW(make("em-galpha", 0.01, {{"linear_solver", "umfpack"}}), std::invalid_argument);
+  EXPECT_THROW(make("em-galpha", 0.01, {{"kbar_basis", "rotated"}}), std::invalid_argument);
+  EXPECT_THROW(make("midpoint", 0.01, {{"kbar_basis", ""}}), std::invalid_argument);
   EXPECT_THROW(make("em-galpha", 0.01, {{"rho_infinity", "1"}}), std::invalid_argument);  // typo: unknown key
   EXPECT_THROW(make("em-galpha", -0.01), std::invalid_argument);
   EXPECT_THROW(make("no-such-scheme", 0.01), std::invalid_argument);
