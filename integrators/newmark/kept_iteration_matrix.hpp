@@ -1,6 +1,8 @@
 // The iteration matrix K̄ that modified Newton keeps across steps, and what a checkpoint needs to continue
 // with it bitwise (docs/architecture.md "Checkpoints and resume"): the last step size (K̄ depends on h),
-// the K̄ in use and the iterations done with it. Shared by em-galpha (and its family) and em-exact.
+// the K̄ in use, the iterations done with it and, with kbar_basis ≠ fixed, the configuration it was formed at,
+// from which each later iteration sees it through a change of unknowns (docs/theory.md §6.9). Shared by
+// em-galpha (and its family) and em-exact.
 #pragma once
 
 #include "integrators/integrator.hpp"
@@ -17,8 +19,6 @@ namespace shelldyn {
 
 class KeptIterationMatrix {
  public:
-  // At the start of every step: a new h makes the kept K̄ useless. Steps that land on an output time differ
-  // from Δt in the last bits (t_out − t); that is no reason to throw a factorization away.
   // How a kept K̄ is seen from later configurations (setting `kbar_basis`, docs/theory.md §6.9): `fixed` uses it
   // in the unknowns it was formed in; `charts` transforms it to the current director charts of nodes whose chart
   // switched since; `corotated` also rotates it with the best-fit rigid rotation of the body since (unconstrained
@@ -128,13 +128,13 @@ class KeptIterationMatrix {
   }
 
  private:
-  // The node blocks of T⁻¹ (25 numbers per node, row-major 5 × 5 with the 3 × 3 and 2 × 2 blocks) as
+  // The node blocks of T⁻¹ (25 numbers per node, row-major kDofsPerNode² with the 3 × 3 and 2 × 2 blocks) as
   // NewtonSolver blocks, identity blocks left out.
   void make_blocks(std::vector<NewtonSolver::BasisBlock>& blocks) const {
     const size_t nn = node_inverse_.size() / 25;
     for (size_t i = 0; i < nn; ++i) {
       const double* B = node_inverse_.data() + 25 * i;
-      const Index d0 = static_cast<Index>(5 * i);
+      const Index d0 = DofMap::dof(static_cast<int>(i), 0);
       for (int part = 0; part < 2; ++part) {
         const int off = part == 0 ? 0 : 3, size = part == 0 ? 3 : 2;
         NewtonSolver::BasisBlock b;
