@@ -443,19 +443,28 @@ bool Model::kept_matrix_basis(const Eigen::VectorXd& u_ref, const std::vector<Di
     if ((R - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff() <= 1e-12) R.setIdentity();
   }
   const bool rotated = !R.isIdentity(0.0);
+  auto switched = [&](int i) {
+    const DirectorChart& a = charts_ref[static_cast<size_t>(i)];
+    const DirectorChart& b = charts[static_cast<size_t>(i)];
+    return a.n != b.n || a.m != b.m || a.l != b.l || a.s != b.s;
+  };
+  if (!rotated) {  // T = I unless a chart switched (a body that does not turn: every iteration ends here)
+    bool any = false;
+    for (int i = 0; i < nn && !any; ++i) any = switched(i);
+    if (!any) return false;
+  }
   node_inverse.assign(static_cast<size_t>(25 * nn), 0.0);
-  bool changed = false;
   for (int i = 0; i < nn; ++i) {
     double* B = node_inverse.data() + 25 * i;
     for (int a = 0; a < 3; ++a)
       for (int b = 0; b < 3; ++b) B[5 * a + b] = R(a, b);  // T_d⁻¹ = R
     const DirectorChart& cr = charts_ref[static_cast<size_t>(i)];
     const DirectorChart& ch = charts[static_cast<size_t>(i)];
-    const bool switched = cr.n != ch.n || cr.m != ch.m || cr.l != ch.l || cr.s != ch.s;
+    const bool node_switched = switched(i);
     Eigen::Matrix2d Tq_inv = Eigen::Matrix2d::Identity();
-    if (rotated || switched) {
+    if (rotated || node_switched) {
       const Index k = DofMap::dof(i, 3);
-      if (switched && (dofs_.is_constrained(k) || dofs_.is_constrained(k + 1)))
+      if (node_switched && (dofs_.is_constrained(k) || dofs_.is_constrained(k + 1)))
         throw std::domain_error("node " + std::to_string(i) + " switched the chart of constrained director unknowns");
       // T_q = S_ref Rᵀ A1(q): rows n_ref, m_ref of Rᵀ A1.
       const Eigen::Matrix<double, 3, 2> RA = R.transpose() * shelldyn::director_A1(u.segment<2>(k), ch);
@@ -469,9 +478,8 @@ bool Model::kept_matrix_basis(const Eigen::VectorXd& u_ref, const std::vector<Di
     }
     for (int a = 0; a < 2; ++a)
       for (int b = 0; b < 2; ++b) B[5 * (3 + a) + 3 + b] = Tq_inv(a, b);
-    changed = changed || rotated || switched;
   }
-  return changed;
+  return true;
 }
 
 // ---- em-exact (docs/theory/exact-energy-momentum.md) ------------------------------------------------------

@@ -85,9 +85,9 @@ class SemiDiscreteSystem {
   virtual double chart_margin(const State& s) const = 0;
 
   // A kept iteration matrix seen from another configuration (docs/theory.md §6.9). The matrix was formed at
-  // (u_ref, charts_ref); the unknowns now are (u, charts). Fills, per node i, the inverse of the 5 × 5 block
-  // T_i of δu_ref = T δu as node_inverse[25 i ..] (row-major), and returns true when some T_i differs from the
-  // identity. `rotate`: T carries the rigid rotation R that best maps the nodes at u_ref onto those at u
+  // (u_ref, charts_ref); the unknowns now are (u, charts). Returns true when some block T_i of δu_ref = T δu
+  // differs from the identity, and then fills, per node i, the inverse of the 5 × 5 block T_i as
+  // node_inverse[25 i ..] (row-major); returns false (T = I) without touching node_inverse. `rotate`: T carries the rigid rotation R that best maps the nodes at u_ref onto those at u
   // (T_d = Rᵀ, T_q = S_ref Rᵀ A1(q)); otherwise R = I and only nodes whose chart switched have T_i ≠ I.
   // Throws std::domain_error when the change cannot be represented (the caller then refreshes the matrix).
   // Systems without directors return false (no change).

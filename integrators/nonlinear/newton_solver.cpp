@@ -62,8 +62,8 @@ void validate(const NewtonOptions& o) {
 // (bitwise the inner solver's).
 class BasisChangeSolver final : public LinearSolver {
  public:
-  BasisChangeSolver(std::unique_ptr<LinearSolver> inner, const std::vector<NewtonSolver::BasisBlock>* blocks)
-      : inner_(std::move(inner)), blocks_(blocks) {}
+  BasisChangeSolver(std::unique_ptr<LinearSolver> inner, const std::vector<NewtonSolver::BasisBlock>* blocks, Index n)
+      : inner_(std::move(inner)), blocks_(blocks), n_(n) {}
   std::string name() const override { return inner_->name(); }
   void analyze(const CscView& A) override {
     inner_->analyze(A);
@@ -101,12 +101,11 @@ class BasisChangeSolver final : public LinearSolver {
   bool factorized() const override { return inner_->factorized(); }
   long negative_pivots() const override { return inner_->negative_pivots(); }
   bool set_single_precision_solves(bool on) override { return inner_->set_single_precision_solves(on); }
-  void set_size(Index n) { n_ = n; }
 
  private:
   std::unique_ptr<LinearSolver> inner_;
   const std::vector<NewtonSolver::BasisBlock>* blocks_;
-  Index n_ = 0;
+  Index n_;  // unknowns
   mutable std::vector<double> work_;
 };
 
@@ -239,9 +238,7 @@ NewtonSolver::NewtonSolver(std::shared_ptr<const SparsePattern> pattern, NewtonO
       throw std::invalid_argument("NewtonSolver: linear_solver '" + s.opt.linear_solver +
                                   "' has no single-precision solves (docs/dependencies.md §5.5); use cholmod, "
                                   "or double solves");
-    auto wrapped = std::make_unique<BasisChangeSolver>(std::move(ls), &s.basis);
-    wrapped->set_size(s.n);
-    s.LS.reset(make_sun_linear_solver(s.ctx, std::move(wrapped)));
+    s.LS.reset(make_sun_linear_solver(s.ctx, std::make_unique<BasisChangeSolver>(std::move(ls), &s.basis, s.n)));
   }
   s.Jwork.pattern = pattern;
   s.Jwork.values.assign(pattern->nnz(), 0.0);

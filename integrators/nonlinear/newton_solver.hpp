@@ -202,7 +202,6 @@ class NewtonSolver {
   int iterations_since_setup() const;
   void resume_after_setup(int k);
 
-
   const NewtonOptions& options() const;
   const LinearSolver& linear_solver() const;  // stats(): analyses stay at 1 for a fixed pattern
 
