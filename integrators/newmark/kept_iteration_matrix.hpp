@@ -5,6 +5,7 @@
 // em-galpha (and its family) and em-exact.
 #pragma once
 
+#include "elements/director.hpp"
 #include "integrators/integrator.hpp"
 #include "integrators/nonlinear/newton_solver.hpp"
 #include "lib/semi_discrete_system.hpp"
@@ -96,7 +97,8 @@ class KeptIterationMatrix {
       c.vectors["kbar_u_ref"] = u_ref_;
       Eigen::VectorXd ch(4 * static_cast<Index>(charts_ref_.size()));
       for (size_t i = 0; i < charts_ref_.size(); ++i)
-        ch.segment<4>(4 * static_cast<Index>(i)) << charts_ref_[i].n, charts_ref_[i].m, charts_ref_[i].l, charts_ref_[i].s;
+        ch.segment<4>(4 * static_cast<Index>(i)) << charts_ref_[i].n, charts_ref_[i].m, charts_ref_[i].l,
+            charts_ref_[i].s > 0 ? 1.0 : -1.0;  // as the state's charts (checkpoint.cpp)
       c.vectors["kbar_charts_ref"] = ch;
     }
   }
@@ -123,6 +125,11 @@ class KeptIterationMatrix {
       for (size_t i = 0; i < charts_ref_.size(); ++i) {
         const Index k = 4 * static_cast<Index>(i);
         charts_ref_[i] = DirectorChart{static_cast<int>(ch[k]), static_cast<int>(ch[k + 1]), static_cast<int>(ch[k + 2]), ch[k + 3]};
+        try {
+          check_chart(charts_ref_[i]);
+        } catch (const std::invalid_argument& e) {
+          throw std::runtime_error(who + ": checkpoint kbar_charts_ref: " + e.what());
+        }
       }
     }
   }

@@ -223,6 +223,32 @@ TEST(CheckpointNewmark, EmGalphaModifiedNewtonAtEveryRefreshPhase) {
 }
 
 // em-exact carries the embedded director velocities (State::pdot) and its own diagnostics.
+TEST(CheckpointNewmark, DamagedKbarReferenceChartsAreRejected) {
+  // kbar_basis (docs/theory.md §6.9): the checkpoint keeps the configuration and charts the kept K̄ was formed
+  // at; a chart that is not a permutation (a damaged file) is refused on restore, as the state's charts are.
+  auto model = spin_plate(1e4);
+  IntegratorSettings settings("em-galpha", {{"newton", "modified"}});
+  auto integ = make_integrator(settings, 0.01);
+  State st = spin_state(*model, Vec3(3.0, 0.4, 0.2));
+  integ->initialize(*model, st);
+  integ->advance(*model, st, 0.05);
+  IntegratorCheckpoint c;
+  integ->save(c);
+  ASSERT_EQ(c.vectors.count("kbar_charts_ref"), 1u);
+  ASSERT_EQ(c.vectors.at("kbar_u_ref").size(), model->num_dofs());
+  c.vectors["kbar_charts_ref"][0] = 7.0;
+  IntegratorSettings settings2("em-galpha", {{"newton", "modified"}});
+  auto fresh = make_integrator(settings2, 0.01);
+  State s2 = model->initial_state();
+  fresh->initialize(*model, s2);
+  try {
+    fresh->restore(*model, st, c);
+    FAIL() << "a damaged reference chart was accepted";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("kbar_charts_ref"), std::string::npos) << e.what();
+  }
+}
+
 TEST(CheckpointEmExact, FullNewtonContinuesBitwise) { expect_bitwise_continuation("em-exact", {}, 5); }
 TEST(CheckpointEmExact, DissipativeContinuesBitwise) { expect_bitwise_continuation("em-exact", {{"rho_inf", "0.8"}, {"max_cuts", "3"}}, 3); }
 TEST(CheckpointEmExact, ModifiedNewtonContinuesBitwiseAtEveryRefreshPhase) {
