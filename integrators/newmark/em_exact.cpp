@@ -50,12 +50,15 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
     kept_.set_basis(KeptIterationMatrix::parse_basis(s.get("kbar_basis", std::string("corotated")), std::string("em-exact")));
     // CHOLMOD's supernodal Cholesky as em-galpha (faster solves than Eigen's simplicial LDLᵀ, no hidden threads).
     nopt_.linear_solver = s.get("linear_solver", "cholmod");
-    // Predictor (theory §5): u_n, or with modified Newton the trapezoidal extrapolation d_n + Δt v_n + Δt²/2 a_n,
-    // p_n + Δt w_n (a failed step is retried from u_n with full Newton).
+    // Predictor (theory §5, §5.7): u_n, or with modified Newton the trapezoidal extrapolation d_n + Δt v_n + Δt²/2 a_n,
+    // p_n + Δt w_n + Δt²/2 ẇ_n with the last step's accelerations a_n = Δv/Δt, ẇ_n = Δw/Δt ("trapezoidal"), or
+    // without the director term ("trapezoidal-v", the predictor before the fourteenth session). A failed step is
+    // retried from u_n with full Newton.
     const std::string predictor = s.get("predictor", nopt_.modified ? "trapezoidal" : "none");
-    if (predictor != "none" && predictor != "trapezoidal")
-      throw std::invalid_argument("em-exact.predictor: '" + predictor + "' (use none or trapezoidal)");
-    predictor_ = (predictor == "trapezoidal");
+    if (predictor != "none" && predictor != "trapezoidal" && predictor != "trapezoidal-v")
+      throw std::invalid_argument("em-exact.predictor: '" + predictor + "' (use none, trapezoidal or trapezoidal-v)");
+    predictor_ = (predictor != "none");
+    director_acceleration_ = (predictor == "trapezoidal");
     make_linear_solver(nopt_.linear_solver);
     nopt_.single_precision_solves =  // float copy of the kept factor (docs/dependencies.md §5.5)
         single_precision_setting(s.get("solve_precision", "double"), nopt_.linear_solver, "em-exact");
@@ -134,6 +137,7 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
     c.scalars["renew_iterations"] = static_cast<double>(renew_iterations_);
     // certify = floor: the floors of the recent steps (the next step's acceptance depends on them).
     for (long j = 0; j < kFloorSteps; ++j) c.scalars["floor_" + std::to_string(j)] = recent_floor_[static_cast<size_t>(j)];
+    c.vectors["director_acceleration"] = wdot_;  // the predictor's ẇ_n (theory §5.7)
     kept_.save(c, *newton_, nopt_.modified);
   }
 
@@ -161,6 +165,18 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
       const std::string key = "floor_" + std::to_string(j);
       recent_floor_[static_cast<size_t>(j)] = c.scalars.count(key) ? c.scalar(key) : 0.0;
     }
+    // The predictor's ẇ_n; absent from checkpoints written before it existed, whose runs then continue with ẇ_n = 0
+    // for one step (not bitwise: their first step's predictor differs).
+    const auto wd = c.vectors.find("director_acceleration");
+    if (wd == c.vectors.end()) {
+      wdot_.setZero(3 * nn_);
+    } else {
+      if (wd->second.size() != 3 * nn_ || !wd->second.allFinite())
+        throw std::runtime_error("em-exact: checkpoint vector 'director_acceleration' has " +
+                                 std::to_string(wd->second.size()) + " entries or a non-finite one; expected " +
+                                 std::to_string(3 * nn_) + " finite entries (3 per node)");
+      wdot_ = wd->second;
+    }
     kept_.restore(c, *newton_, nopt_.modified, sys.pattern()->nnz(), "em-exact");
   }
 
@@ -179,7 +195,7 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
     M_ = model_->make_matrix();
     K_ = M_;
     for (Eigen::VectorXd* v : {&un_, &umid_, &fint_, &r_, &last_u_}) v->setZero(n);
-    for (Eigen::VectorXd* v : {&vn_, &wn_, &pn_, &p1_, &pmid_, &v1_, &w1_, &dv_, &dw_, &mv_, &mw_, &fd_, &g_}) v->setZero(3 * nn_);
+    for (Eigen::VectorXd* v : {&wdot_, &vn_, &wn_, &pn_, &p1_, &pmid_, &v1_, &w1_, &dv_, &dw_, &mv_, &mw_, &fd_, &g_}) v->setZero(3 * nn_);
     work_ = prescribed_work_ = 0.0;
     recent_floor_.fill(0.0);
     renew_steps_ = renew_iterations_ = 0;
@@ -383,9 +399,14 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
       if (rk <= stall_tol_ && rk > stall_ratio_ * prev_best) {
         // Stagnation at the round-off floor if the iteration matrix was fresh, or if the corrections have
         // already shrunk by stall_step relative to the first (the iteration converged; what stalls is the
-        // residual's round-off, theory §5); otherwise refresh the matrix first.
+        // residual's round-off, theory §5), or if the residual is at the floor of the recent steps; otherwise
+        // refresh the matrix first.
         // (With certify = floor, "converged_step" reads Δu_k, one correction later than the stalled u_{k−1}.)
-        if (last_jacobian_iter >= k - 1 || converged_step) return true;
+        // A stall within floor_margin of the recent steps' floor is that floor too (theory §5.7): the corrections
+        // at the floor are round-off, and measured against the first correction they are larger the better the
+        // predictor was, so without it a good predictor turned stalls at the floor into refreshes of K̄.
+        if (last_jacobian_iter >= k - 1 || converged_step || (recent_floor > 0.0 && rk <= floor_margin_ * recent_floor))
+          return true;
         newton.invalidate_jacobian();
         return false;
       }
@@ -409,7 +430,8 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
       for (int i = 0; i < nn_; ++i) {
         const Index k = DofMap::dof(i, 0);
         u.segment<3>(k) += h * vn_.segment<3>(3 * i) + (0.5 * h * h) * s.a.segment<3>(k);
-        const Vec3 p = pn_.segment<3>(3 * i) + h * wn_.segment<3>(3 * i);
+        Vec3 p = pn_.segment<3>(3 * i) + h * wn_.segment<3>(3 * i);
+        if (director_acceleration_) p += (0.5 * h * h) * wdot_.segment<3>(3 * i);
         u.segment<2>(k + 3) = chart_coordinates(p.normalized(), charts[static_cast<size_t>(i)]);
       }
       for (Index d : sys.dofs().constrained_dofs()) u[d] = un_[d];  // constrained entries stay bitwise u_n
@@ -499,6 +521,7 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
       s.a.segment<2>(k + 3) = chart_coordinates(Vec3((w1_ - wn_).segment<3>(3 * i) / h), ch);
     }
     s.pdot = w1_;
+    wdot_ = (w1_ - wn_) / h;  // ẇ_n of the next step's predictor (theory §5.7)
     s.u = u;
     s.t = t1;
     ++steps_;
@@ -532,6 +555,10 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
   SparseMatrix M_, K_;
   std::vector<CR9Shell::Mat45> k0_;
   std::vector<double> Un_;
+  // The last step's director accelerations (w_{n+1} − w_n)/Δt in ℝ³ (3 per node; 0 before the first step): the
+  // predictor's ẇ_n. Chart-free, so a chart switch between steps does not touch it; saved in checkpoints.
+  Eigen::VectorXd wdot_;
+  bool director_acceleration_ = false;  // predictor = trapezoidal (theory §5.7)
   Eigen::VectorXd un_, umid_, fint_, r_, last_u_, last_r_, uscale_;
   Eigen::VectorXd vn_, wn_, pn_, p1_, pmid_, v1_, w1_, dv_, dw_, mv_, mw_, fd_, g_;
   double work_ = 0.0, prescribed_work_ = 0.0;

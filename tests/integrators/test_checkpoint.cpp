@@ -249,6 +249,39 @@ TEST(CheckpointNewmark, DamagedKbarReferenceChartsAreRejected) {
   }
 }
 
+TEST(CheckpointEmExact, DamagedDirectorAccelerationIsRejected) {
+  // The predictor's director accelerations (docs/theory/exact-energy-momentum.md §5.7) are part of the checkpoint; a
+  // vector of the wrong length or with a non-finite entry (a damaged file) is refused on restore with its key named.
+  auto model = spin_plate(1e4);
+  for (int damage = 0; damage < 2; ++damage) {
+    IntegratorSettings settings("em-exact", {{"newton", "modified"}});
+    auto integ = make_integrator(settings, 0.01);
+    State st = spin_state(*model, Vec3(3.0, 0.4, 0.2));
+    integ->initialize(*model, st);
+    integ->advance(*model, st, 0.05);
+    IntegratorCheckpoint c;
+    integ->save(c);
+    ASSERT_EQ(c.vectors.at("director_acceleration").size(), 3 * model->mesh().num_nodes());
+    ASSERT_GT(c.vectors.at("director_acceleration").norm(), 0.0);  // a spinning plate's directors accelerate
+    Eigen::VectorXd& wd = c.vectors["director_acceleration"];
+    if (damage == 0) {
+      wd.conservativeResize(wd.size() - 1);
+    } else {
+      wd[1] = std::numeric_limits<double>::quiet_NaN();
+    }
+    IntegratorSettings settings2("em-exact", {{"newton", "modified"}});
+    auto fresh = make_integrator(settings2, 0.01);
+    State s2 = model->initial_state();
+    fresh->initialize(*model, s2);
+    try {
+      fresh->restore(*model, st, c);
+      FAIL() << "a damaged director_acceleration was accepted";
+    } catch (const std::runtime_error& e) {
+      EXPECT_NE(std::string(e.what()).find("director_acceleration"), std::string::npos) << e.what();
+    }
+  }
+}
+
 TEST(CheckpointEmExact, FullNewtonContinuesBitwise) { expect_bitwise_continuation("em-exact", {}, 5); }
 TEST(CheckpointEmExact, DissipativeContinuesBitwise) { expect_bitwise_continuation("em-exact", {{"rho_inf", "0.8"}, {"max_cuts", "3"}}, 3); }
 TEST(CheckpointEmExact, ModifiedNewtonContinuesBitwiseAtEveryRefreshPhase) {
