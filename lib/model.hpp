@@ -171,6 +171,7 @@ class Model final : public SemiDiscreteSystem {
   std::vector<NodalLoad> loads_;
   Assembler assembler_;
   std::vector<CR9Shell> elements_;
+  std::vector<Eigen::Matrix<double, 9, 9>, Eigen::aligned_allocator<Eigen::Matrix<double, 9, 9>>> scalar_masses_;  // m_ij of each element (em-exact)
   std::vector<FollowerPressure> follower_;
   bool full_load_tangent_ = false;
   SparseMatrix damping_;  // empty values: no damping

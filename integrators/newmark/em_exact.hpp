@@ -25,8 +25,8 @@
 // Newton too; a stop request (SIGINT, --max-wall) is honoured at the next step boundary.
 // Stopping (theory §5): the scaled residual ‖r‖∞ / (‖inertia‖∞ + ‖F*‖∞ + ‖F_ext‖∞) ≤ res_tol, or, once it is
 // below stall_tol, an iteration that does not reduce the best residual by stall_ratio (the round-off floor of
-// the co-rotational force), accepted with a fresh K̄ or once the corrections have shrunk by stall_step
-// relative to the first; the last iterate is accepted (docs/theory/exact-energy-momentum.md §5, §5.1). With
+// the co-rotational force), accepted with a fresh K̄, once the corrections have shrunk by stall_step
+// relative to the first, or at the recent steps' floor (§5.7); the last iterate is accepted (docs/theory/exact-energy-momentum.md §5, §5.1). With
 // certify = floor that iterate is accepted without evaluating its residual, once the one before it is
 // seen to be at the floor (§5.3). certify = predicted accepts one correction earlier, once the contraction
 // predicts the floor for the iterate (§5.4): fewer iterations, a larger (still round-off-sized) energy error.
