@@ -16,6 +16,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <limits>
 
 namespace shelldyn {
@@ -222,64 +223,53 @@ TEST(CheckpointNewmark, EmGalphaModifiedNewtonAtEveryRefreshPhase) {
     expect_bitwise_continuation("em-galpha", {{"newton", "modified"}, {"setup_every", "2"}}, stop_after);
 }
 
-// em-exact carries the embedded director velocities (State::pdot) and its own diagnostics.
-TEST(CheckpointNewmark, DamagedKbarReferenceChartsAreRejected) {
-  // kbar_basis (docs/theory.md §6.9): the checkpoint keeps the configuration and charts the kept K̄ was formed
-  // at; a chart that is not a permutation (a damaged file) is refused on restore, as the state's charts are.
+// Saves `integrator` (modified Newton) after 5 steps of a spinning plate, lets `damage` change the checkpoint as a
+// damaged file would, and expects restore() to refuse it with a runtime_error that names `key`.
+void expect_damaged_checkpoint_refused(const std::string& integrator, const std::string& key,
+                                       const std::function<void(IntegratorCheckpoint&)>& damage) {
   auto model = spin_plate(1e4);
-  IntegratorSettings settings("em-galpha", {{"newton", "modified"}});
+  IntegratorSettings settings(integrator, {{"newton", "modified"}});
   auto integ = make_integrator(settings, 0.01);
   State st = spin_state(*model, Vec3(3.0, 0.4, 0.2));
   integ->initialize(*model, st);
   integ->advance(*model, st, 0.05);
   IntegratorCheckpoint c;
   integ->save(c);
-  ASSERT_EQ(c.vectors.count("kbar_charts_ref"), 1u);
-  ASSERT_EQ(c.vectors.at("kbar_u_ref").size(), model->num_dofs());
-  c.vectors["kbar_charts_ref"][0] = 7.0;
-  IntegratorSettings settings2("em-galpha", {{"newton", "modified"}});
+  ASSERT_EQ(c.vectors.count(key), 1u) << key;
+  damage(c);
+  IntegratorSettings settings2(integrator, {{"newton", "modified"}});
   auto fresh = make_integrator(settings2, 0.01);
   State s2 = model->initial_state();
   fresh->initialize(*model, s2);
   try {
     fresh->restore(*model, st, c);
-    FAIL() << "a damaged reference chart was accepted";
+    FAIL() << "a damaged " << key << " was accepted";
   } catch (const std::runtime_error& e) {
-    EXPECT_NE(std::string(e.what()).find("kbar_charts_ref"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find(key), std::string::npos) << e.what();
   }
 }
 
+TEST(CheckpointNewmark, DamagedKbarReferenceChartsAreRejected) {
+  // kbar_basis (docs/theory.md §6.9): the checkpoint keeps the configuration and charts the kept K̄ was formed
+  // at; a chart that is not a permutation (a damaged file) is refused on restore, as the state's charts are.
+  expect_damaged_checkpoint_refused("em-galpha", "kbar_charts_ref", [](IntegratorCheckpoint& c) {
+    ASSERT_EQ(c.vectors.count("kbar_u_ref"), 1u);
+    c.vectors["kbar_charts_ref"][0] = 7.0;
+  });
+}
+
+// em-exact carries the embedded director velocities (State::pdot), its own diagnostics and the predictor's
+// director accelerations (docs/theory/exact-energy-momentum.md §5.7): a vector of the wrong length or with a
+// non-finite entry (a damaged file) is refused on restore with its key named.
 TEST(CheckpointEmExact, DamagedDirectorAccelerationIsRejected) {
-  // The predictor's director accelerations (docs/theory/exact-energy-momentum.md §5.7) are part of the checkpoint; a
-  // vector of the wrong length or with a non-finite entry (a damaged file) is refused on restore with its key named.
-  auto model = spin_plate(1e4);
-  for (int damage = 0; damage < 2; ++damage) {
-    IntegratorSettings settings("em-exact", {{"newton", "modified"}});
-    auto integ = make_integrator(settings, 0.01);
-    State st = spin_state(*model, Vec3(3.0, 0.4, 0.2));
-    integ->initialize(*model, st);
-    integ->advance(*model, st, 0.05);
-    IntegratorCheckpoint c;
-    integ->save(c);
-    ASSERT_EQ(c.vectors.at("director_acceleration").size(), 3 * model->mesh().num_nodes());
-    ASSERT_GT(c.vectors.at("director_acceleration").norm(), 0.0);  // a spinning plate's directors accelerate
+  expect_damaged_checkpoint_refused("em-exact", "director_acceleration", [](IntegratorCheckpoint& c) {
     Eigen::VectorXd& wd = c.vectors["director_acceleration"];
-    if (damage == 0) {
-      wd.conservativeResize(wd.size() - 1);
-    } else {
-      wd[1] = std::numeric_limits<double>::quiet_NaN();
-    }
-    IntegratorSettings settings2("em-exact", {{"newton", "modified"}});
-    auto fresh = make_integrator(settings2, 0.01);
-    State s2 = model->initial_state();
-    fresh->initialize(*model, s2);
-    try {
-      fresh->restore(*model, st, c);
-      FAIL() << "a damaged director_acceleration was accepted";
-    } catch (const std::runtime_error& e) {
-      EXPECT_NE(std::string(e.what()).find("director_acceleration"), std::string::npos) << e.what();
-    }
-  }
+    ASSERT_GT(wd.norm(), 0.0);  // a spinning plate's directors accelerate
+    wd.conservativeResize(wd.size() - 1);
+  });
+  expect_damaged_checkpoint_refused("em-exact", "director_acceleration", [](IntegratorCheckpoint& c) {
+    c.vectors["director_acceleration"][1] = std::numeric_limits<double>::quiet_NaN();
+  });
 }
 
 TEST(CheckpointEmExact, FullNewtonContinuesBitwise) { expect_bitwise_continuation("em-exact", {}, 5); }
