@@ -433,6 +433,7 @@ TEST(EmExact, RejectsBadSettingsAndOtherSystems) {
   EXPECT_THROW(make("em-exact", 0.01, {{"predict_factor", "nan"}}), std::invalid_argument);
   EXPECT_THROW(make("em-exact", 0.01, {{"refresh_cost", "-1"}}), std::invalid_argument);
   EXPECT_THROW(make("em-exact", 0.01, {{"kbar_basis", "rotated"}}), std::invalid_argument);
+  EXPECT_THROW(make("em-exact", 0.01, {{"predictor", "trapezoidal-w"}}), std::invalid_argument);
   EXPECT_THROW(make("em-exact", -0.01), std::invalid_argument);
   EXPECT_THROW(make("em-exact", 0.01, {{"cc_tol", "1e-6"}}), std::invalid_argument);  // not an em-exact key
   testing::SpringMass spring(1.0);
