@@ -30,6 +30,14 @@ const Eigen::VectorXd& IntegratorCheckpoint::vector(const std::string& key) cons
   return it->second;
 }
 
+const Eigen::VectorXd& IntegratorCheckpoint::vector(const std::string& key, Index size) const {
+  const Eigen::VectorXd& v = vector(key);
+  if (v.size() != size || !v.allFinite())
+    throw std::runtime_error("checkpoint: integrator vector '" + key + "' has " + std::to_string(v.size()) +
+                             " entries or a non-finite one; expected " + std::to_string(size) + " finite entries");
+  return v;
+}
+
 void Integrator::save(IntegratorCheckpoint&) const {
   throw std::runtime_error("integrator " + name() + " does not support checkpoints (use --checkpoint-every 0)");
 }

@@ -72,6 +72,8 @@ struct IntegratorCheckpoint {
 
   double scalar(const std::string& key) const;                 // throws naming the key if absent
   const Eigen::VectorXd& vector(const std::string& key) const;  // likewise
+  // Likewise, and throws naming the key unless the vector has exactly `size` entries, all finite (a damaged file).
+  const Eigen::VectorXd& vector(const std::string& key, Index size) const;
 };
 
 class Integrator {

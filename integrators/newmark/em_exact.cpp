@@ -167,17 +167,11 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
     }
     // The predictor's ẇ_n; absent from checkpoints written before it existed, whose runs then continue with ẇ_n = 0
     // for one step (not bitwise: their first step's predictor differs).
-    const auto wd = c.vectors.find("director_acceleration");
-    if (wd == c.vectors.end()) {
+    if (c.vectors.count("director_acceleration"))
+      wdot_ = c.vector("director_acceleration", 3 * nn_);
+    else
       wdot_.setZero(3 * nn_);
-    } else {
-      if (wd->second.size() != 3 * nn_ || !wd->second.allFinite())
-        throw std::runtime_error("em-exact: checkpoint vector 'director_acceleration' has " +
-                                 std::to_string(wd->second.size()) + " entries or a non-finite one; expected " +
-                                 std::to_string(3 * nn_) + " finite entries (3 per node)");
-      wdot_ = wd->second;
-    }
-    kept_.restore(c, *newton_, nopt_.modified, sys.pattern()->nnz(), "em-exact");
+    kept_.restore(c, *newton_, nopt_.modified, sys, "em-exact");
   }
 
   void initialize(SemiDiscreteSystem& sys, State& s) override {
@@ -510,6 +504,7 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
       const Index i = dof / kDofsPerNode, c = dof % kDofsPerNode;
       prescribed_work_ += (mv_[3 * i + c] + fint_[dof] - fd_[3 * i + c]) * (u[dof] - un_[dof]);
     }
+    wdot_ = (w1_ - wn_) / h;  // Δw/Δt: the q̈ entries below, and ẇ_n of the next step's predictor (theory §5.7)
     // New state: v, w from the trapezoidal relations; q̇ and q̈ entries hold the chart's minor components of
     // w and Δw/Δt (for output only: the scheme's state is (d, p, v, w)); a_d = Δv/Δt.
     for (int i = 0; i < nn_; ++i) {
@@ -518,10 +513,9 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
       s.v.segment<3>(k) = v1_.segment<3>(3 * i);
       s.a.segment<3>(k) = (v1_.segment<3>(3 * i) - vn_.segment<3>(3 * i)) / h;
       s.v.segment<2>(k + 3) = chart_coordinates(Vec3(w1_.segment<3>(3 * i)), ch);
-      s.a.segment<2>(k + 3) = chart_coordinates(Vec3((w1_ - wn_).segment<3>(3 * i) / h), ch);
+      s.a.segment<2>(k + 3) = chart_coordinates(Vec3(wdot_.segment<3>(3 * i)), ch);
     }
     s.pdot = w1_;
-    wdot_ = (w1_ - wn_) / h;  // ẇ_n of the next step's predictor (theory §5.7)
     s.u = u;
     s.t = t1;
     ++steps_;

@@ -170,7 +170,7 @@ class NewmarkFamily final : public Integrator {
     prescribed_work_ = c.scalars.count("W_presc") ? c.scalar("W_presc") : 0.0;
     steps_ = static_cast<long>(c.scalar("steps"));
     energy0_ = c.scalar("energy0");
-    kept_.restore(c, *newton_, nopt_.modified, sys.pattern()->nnz(), name_);
+    kept_.restore(c, *newton_, nopt_.modified, sys, name_);
   }
 
   void initialize(SemiDiscreteSystem& sys, State& s) override {

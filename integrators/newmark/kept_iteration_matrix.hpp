@@ -103,14 +103,15 @@ class KeptIterationMatrix {
     }
   }
 
-  // `who` names the integrator in the error; `nnz` is the size K̄ must have (the system's pattern).
-  void restore(const IntegratorCheckpoint& c, NewtonSolver& newton, bool modified, Index nnz, const std::string& who) {
+  // `who` names the integrator in the error; `sys` gives the sizes K̄ (its pattern) and the reference
+  // configuration (its unknowns, 5 per node with one chart each) must have.
+  void restore(const IntegratorCheckpoint& c, NewtonSolver& newton, bool modified, const SemiDiscreteSystem& sys,
+               const std::string& who) {
     last_h_ = c.scalar("last_h");
     const int since = static_cast<int>(c.scalar("newton_since_setup"));
     replay_ = false;
     if (modified && since >= 0) {
-      const Eigen::VectorXd& k = c.vector("kbar");
-      if (k.size() != nnz) throw std::runtime_error(who + ": checkpoint K̄ has the wrong size");
+      const Eigen::VectorXd& k = c.vector("kbar", sys.pattern()->nnz());
       kbar_.assign(k.data(), k.data() + k.size());
       replay_ = true;
       newton.resume_after_setup(since);
@@ -118,9 +119,8 @@ class KeptIterationMatrix {
     u_ref_.resize(0);
     charts_ref_.clear();
     if (c.vectors.count("kbar_u_ref")) {
-      u_ref_ = c.vector("kbar_u_ref");
-      const Eigen::VectorXd& ch = c.vector("kbar_charts_ref");
-      if (ch.size() % 4 != 0) throw std::runtime_error(who + ": checkpoint kbar_charts_ref has the wrong size");
+      u_ref_ = c.vector("kbar_u_ref", sys.num_dofs());
+      const Eigen::VectorXd& ch = c.vector("kbar_charts_ref", 4 * (sys.num_dofs() / kDofsPerNode));
       charts_ref_.resize(static_cast<size_t>(ch.size() / 4));
       for (size_t i = 0; i < charts_ref_.size(); ++i) {
         const Index k = 4 * static_cast<Index>(i);

@@ -78,23 +78,9 @@ class BasisChangeSolver final : public LinearSolver {
       inner_->solve(b, x);
     } else {
       work_.assign(b, b + n_);
-      for (const auto& bl : *blocks_) {  // T⁻ᵀ b
-        double y[3];
-        for (int j = 0; j < bl.size; ++j) {
-          y[j] = 0.0;
-          for (int i = 0; i < bl.size; ++i) y[j] += bl.inverse[3 * i + j] * work_[static_cast<size_t>(bl.first + i)];
-        }
-        for (int j = 0; j < bl.size; ++j) work_[static_cast<size_t>(bl.first + j)] = y[j];
-      }
+      for (const auto& bl : *blocks_) apply(bl, true, work_.data());  // T⁻ᵀ b
       inner_->solve(work_.data(), x);
-      for (const auto& bl : *blocks_) {  // T⁻¹ x
-        double y[3];
-        for (int i = 0; i < bl.size; ++i) {
-          y[i] = 0.0;
-          for (int j = 0; j < bl.size; ++j) y[i] += bl.inverse[3 * i + j] * x[bl.first + j];
-        }
-        for (int i = 0; i < bl.size; ++i) x[bl.first + i] = y[i];
-      }
+      for (const auto& bl : *blocks_) apply(bl, false, x);  // T⁻¹ x
     }
     stats_ = inner_->stats();
   }
@@ -103,6 +89,16 @@ class BasisChangeSolver final : public LinearSolver {
   bool set_single_precision_solves(bool on) override { return inner_->set_single_precision_solves(on); }
 
  private:
+  // v ← T⁻¹ v (transposed: T⁻ᵀ v) on the block's unknowns.
+  static void apply(const NewtonSolver::BasisBlock& bl, bool transposed, double* v) {
+    double y[3];
+    for (int i = 0; i < bl.size; ++i) {
+      y[i] = 0.0;
+      for (int j = 0; j < bl.size; ++j) y[i] += (transposed ? bl.inverse[3 * j + i] : bl.inverse[3 * i + j]) * v[bl.first + j];
+    }
+    for (int i = 0; i < bl.size; ++i) v[bl.first + i] = y[i];
+  }
+
   std::unique_ptr<LinearSolver> inner_;
   const std::vector<NewtonSolver::BasisBlock>* blocks_;
   Index n_;  // unknowns

@@ -256,6 +256,14 @@ TEST(CheckpointNewmark, DamagedKbarReferenceChartsAreRejected) {
     ASSERT_EQ(c.vectors.count("kbar_u_ref"), 1u);
     c.vectors["kbar_charts_ref"][0] = 7.0;
   });
+  // The configuration K̄ was formed at must have the system's unknowns, all finite.
+  expect_damaged_checkpoint_refused("em-galpha", "kbar_u_ref", [](IntegratorCheckpoint& c) {
+    Eigen::VectorXd& u = c.vectors["kbar_u_ref"];
+    u.conservativeResize(u.size() - 1);
+  });
+  expect_damaged_checkpoint_refused("em-galpha", "kbar_u_ref", [](IntegratorCheckpoint& c) {
+    c.vectors["kbar_u_ref"][2] = std::numeric_limits<double>::infinity();
+  });
 }
 
 // em-exact carries the embedded director velocities (State::pdot), its own diagnostics and the predictor's
