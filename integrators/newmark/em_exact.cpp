@@ -78,17 +78,16 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
     hysteresis_ = s.get("hysteresis", 1.0);
     correction_ = s.get("correction", true);
     // How the round-off floor is seen (theory §5.3): "residual" evaluates the residual of the accepted
-    // iterate and sees the stall there; "floor" (modified Newton's default) accepts u_k = u_{k−1} + Δu_k
-    // without its residual once u_{k−1}'s residual is within floor_margin of the floor of the recent steps;
-    // "predicted" (theory §5.4) also accepts u_k unevaluated once the residual it is predicted to have,
-    // ρ_{k−1}²/ρ_{k−2}, is within floor_margin/predict_factor of that floor (one correction earlier, not exact to
-    // the floor: a trade of conservation for iterations, measured in §5.4).
-    const std::string certify = s.get("certify", std::string(nopt_.modified ? "floor" : "residual"));
-    if (certify != "residual" && certify != "floor" && certify != "predicted")
-      throw std::invalid_argument("em-exact.certify: '" + certify + "' (use residual, floor or predicted)");
-    certify_floor_ = (certify != "residual");
-    predicted_ = (certify == "predicted");
-    nopt_.skip_final_residual = certify_floor_;
+    // iterate and sees the stall there; "floor" accepts u_k = u_{k−1} + Δu_k without its residual once
+    // u_{k−1}'s residual is within floor_margin of the floor of the recent steps; "predicted" (theory §5.4)
+    // also accepts u_k unevaluated once the residual it is predicted to have, ρ_{k−1}²/ρ_{k−2}, is within
+    // floor_margin/predict_factor of that floor (one correction earlier, not exact to the floor: a trade of
+    // conservation for iterations, measured in §5.4 and §5.8). "auto", the default, is resolved by
+    // initialize(): residual with full Newton; with modified Newton predicted, or floor when the system
+    // prescribes displacements (their reaction work is taken from the last evaluated force, theory §5.8).
+    certify_ = s.get("certify", std::string("auto"));
+    if (certify_ != "auto" && certify_ != "residual" && certify_ != "floor" && certify_ != "predicted")
+      throw std::invalid_argument("em-exact.certify: '" + certify_ + "' (use auto, residual, floor or predicted)");
     floor_margin_ = s.get("floor_margin", 1.5);
     predict_factor_ = s.get("predict_factor", 1.0);
     if (!(predict_factor_ > 0.0) || !std::isfinite(predict_factor_))
@@ -184,6 +183,15 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
                                   "integrator (use em-galpha, or remove 'damping' / the follower_pressure loads)");
     const Index n = sys.num_dofs();
     nn_ = model_->mesh().num_nodes();
+    // certify = auto (constructor): resolved here, where the system is known; run.json records the result.
+    std::string certify = certify_;
+    if (certify == "auto")
+      certify = !nopt_.modified ? "residual" : sys.has_prescribed_motion() ? "floor" : "predicted";
+    certify_floor_ = (certify != "residual");
+    predicted_ = (certify == "predicted");
+    nopt_.skip_final_residual = certify_floor_;
+    for (auto& kv : resolved_)
+      if (kv.first == "certify") kv.second = certify;  // a valid value: run.json's integrator block reruns as is
     newton_ = std::make_unique<NewtonSolver>(sys.pattern(), nopt_);
     full_newton_.reset();
     M_ = model_->make_matrix();
@@ -532,6 +540,7 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
   int max_cuts_ = 0;
   double hysteresis_ = 1.0;
   bool correction_ = true;
+  std::string certify_;          // the setting: auto, residual, floor or predicted (resolved by initialize())
   bool certify_floor_ = false;  // certify = floor or predicted (theory §5.3)
   bool predicted_ = false;      // certify = predicted (theory §5.4)
   double floor_margin_ = 1.5;

@@ -17,9 +17,10 @@
 //   setup_every [20; 1e6 when refresh > 0], predictor none|trapezoidal|trapezoidal-v [trapezoidal with modified
 //   Newton, else none; trapezoidal-v leaves out the directors' acceleration term, theory §5.7], linear_solver [cholmod], solve_precision [double] (or single: float copy
 //   of the factor, docs/dependencies.md §5.5), res_tol [1e-12], stall_tol [1e-6], stall_ratio [0.5],
-//   stall_step [1e-6], max_iters [25], max_cuts [0], hysteresis [1], certify residual|floor|predicted [floor with
-//   modified Newton, else residual] and floor_margin [1.5] (theory §5.3), predict_factor [1] (certify = predicted:
-//   safety factor on the predicted residual, theory §5.4),
+//   stall_step [1e-6], max_iters [25], max_cuts [0], hysteresis [1], certify auto|residual|floor|predicted [auto:
+//   with modified Newton predicted, or floor when the system prescribes displacements (theory §5.8); else
+//   residual] and floor_margin [1.5] (theory §5.3), predict_factor [1] (certify = predicted: safety factor on
+//   the predicted residual, theory §5.4),
 //   correction [true] (false = the paper's force without the §3 correction: for tests that must fail).
 // Checkpoints (docs/architecture.md "Checkpoints and resume"): save/restore continue bitwise, with modified
 // Newton too; a stop request (SIGINT, --max-wall) is honoured at the next step boundary.
@@ -28,8 +29,9 @@
 // the co-rotational force), accepted with a fresh K̄, once the corrections have shrunk by stall_step
 // relative to the first, or at the recent steps' floor (§5.7); the last iterate is accepted (docs/theory/exact-energy-momentum.md §5, §5.1). With
 // certify = floor that iterate is accepted without evaluating its residual, once the one before it is
-// seen to be at the floor (§5.3). certify = predicted accepts one correction earlier, once the contraction
-// predicts the floor for the iterate (§5.4): fewer iterations, a larger (still round-off-sized) energy error.
+// seen to be at the floor (§5.3). certify = predicted (modified Newton's default) accepts one correction
+// earlier, once the contraction predicts the floor for the iterate (§5.4, §5.8): fewer iterations, a larger
+// (still round-off-sized, but one-signed) energy error; certify = floor is the choice for long stiff runs.
 #pragma once
 
 #include "integrators/integrator.hpp"

@@ -89,7 +89,8 @@ const Eigen::Vector3d kV0(0.1, 0.0, 0.2), kW(0.3, 0.5, 1.0);
 // With the correction off the gap is the scheme's own error (8.6e-8 on the free plate).
 double round_off_bound(const Flight& r) { return 4.0 * 2.2e-16 * static_cast<double>(std::max(r.steps, 1L)); }
 
-void print(const char* what, const Flight& r) {
+void print(const std::string& what_s, const Flight& r) {
+  const char* what = what_s.c_str();
   std::printf("%-42s max|dH|/H %.2e  max|dL|/|L| %.2e  max|dJ|/|J| %.2e  strain/H %.2e  %.2f it/step  %ld switches  res %.1e\n",
               what, r.max_dH, r.max_dL, r.max_dJ, r.max_strain, double(r.iterations) / std::max(r.steps, 1L), r.switches,
               r.max_residual);
@@ -163,11 +164,13 @@ TEST(EmExact, TumblingStiffPlateShortRun) {
 // once the corrections have shrunk by stall_step (docs/theory/exact-energy-momentum.md §5) keep the
 // balances of the full-Newton runs above, with fewer iterations than the predictor u_n.
 TEST(EmExact, ModifiedNewtonKeepsTheBalances) {
-  // certify = floor, modified Newton's default: the accepted iterate's residual is not evaluated, so
-  // the identity check runs on the same run with certify = residual below.
+  // certify = floor: the accepted iterate's residual is not evaluated, so the identity check runs on the
+  // same run with certify = residual below.
   const std::vector<std::pair<std::string, std::string>> modified = {{"newton", "modified"}};
-  const Flight r = fly("em-exact", 1e6, 0.01, 200, kV0, kW, 0.5, modified);
-  print("free plate, modified Newton, dt 0.01, 2 s", r);
+  auto floor = modified;
+  floor.emplace_back("certify", "floor");
+  const Flight r = fly("em-exact", 1e6, 0.01, 200, kV0, kW, 0.5, floor);
+  print("free plate, modified Newton, certify = floor, 2 s", r);
   EXPECT_LT(r.max_dH, 1e-10);
   EXPECT_LT(r.max_dJ, 1e-9);
   EXPECT_LT(r.max_dL, 1e-12);
@@ -184,32 +187,31 @@ TEST(EmExact, ModifiedNewtonKeepsTheBalances) {
               double(r.residuals) / r.steps, double(rr.residuals) / rr.steps, r.unevaluated_steps, r.steps);
   EXPECT_GT(r.unevaluated_steps, r.steps / 4);
   EXPECT_LT(r.residuals, rr.residuals);
-  // certify = predicted (theory §5.4) stops a correction earlier still, on the residual predicted from the
-  // contraction: fewer residuals, the balances within the same bounds.
-  auto predicted = modified;
-  predicted.emplace_back("certify", "predicted");
-  const Flight rp = fly("em-exact", 1e6, 0.01, 200, kV0, kW, 0.5, predicted);
-  print("  same, certify = predicted", rp);
+  // certify = predicted (theory §5.4; modified Newton's default, §5.8) stops a correction earlier still, on the
+  // residual predicted from the contraction: fewer residuals, the balances within the same bounds.
+  const Flight rp = fly("em-exact", 1e6, 0.01, 200, kV0, kW, 0.5, modified);
+  print("  same, certify = predicted (default)", rp);
   std::printf("  residuals per step: certify predicted %.2f\n", double(rp.residuals) / rp.steps);
   EXPECT_LT(rp.max_dH, 1e-10);
   EXPECT_LT(rp.max_dJ, 1e-9);
   EXPECT_LT(rp.max_dL, 1e-12);
   EXPECT_LT(rp.residuals, r.residuals);
-  auto u_n = modified;
+  auto u_n = floor;
   u_n.emplace_back("predictor", "none");
   const Flight r0 = fly("em-exact", 1e6, 0.01, 200, kV0, kW, 0.5, u_n);
-  print("  same, predictor u_n", r0);
+  print("  same, certify = floor, predictor u_n", r0);
   EXPECT_LT(r.iterations, r0.iterations);
   // The stiff tumbling plate (E = 1e8), where the floor is highest (§5.1).
-  for (const auto& settings : {modified, residual}) {
+  for (const auto& settings : {modified, floor, residual}) {
     auto model = free_plate(2.0, 1.0, 4, 2, ShellMaterial{1e8, 0.3, 1.0, 0.1});
     State s = model->initial_state();
     set_free_flight_velocity(*model, s, Eigen::Vector3d::Zero(), Eigen::Vector3d(0.01, 1.0, 0.01), 0.0);
     const Flight t = run(*model, s, "em-exact", 0.01, 200, settings);
-    print(settings.size() == 1 ? "tumbling plate, modified Newton, dt 0.01, 2 s" : "  same, certify = residual", t);
+    print(settings.size() == 1 ? "tumbling plate, modified Newton (certify = predicted), dt 0.01, 2 s"
+                               : "  same, certify = " + settings.back().second, t);
     EXPECT_LT(t.max_dH, 1e-10);
     EXPECT_LT(t.max_dJ, 1e-9);
-    if (settings.size() > 1) {
+    if (settings == residual) {
       EXPECT_LT(t.identity_gap, round_off_bound(t));
     }
   }
@@ -229,7 +231,7 @@ HemisphereRun run_hemisphere(const std::string& predictor, int steps) {
   Problem p = load_problem(std::string(SHELLDYN_SOURCE_DIR) + "/apps/cases/pinched-hemisphere.yaml");
   State s = p.initial_state();
   const double dt = p.spec.time.dt;
-  auto integ = make("em-exact", dt, {{"newton", "modified"}, {"hysteresis", "1.1"}, {"predictor", predictor}});
+  auto integ = make("em-exact", dt, {{"newton", "modified"}, {"hysteresis", "1.1"}, {"predictor", predictor}, {"certify", "floor"}});
   integ->initialize(*p.model, s);
   HemisphereRun r;
   double worst = 0.0, energy = 0.0;
@@ -262,7 +264,7 @@ TEST(EmExact, DirectorAccelerationInThePredictorSavesIterations) {
     Problem p = load_problem(std::string(SHELLDYN_SOURCE_DIR) + "/apps/cases/flying-plate.yaml");
     State s = p.initial_state();
     const double dt = p.spec.time.dt;
-    auto integ = make("em-exact", dt, {{"newton", "modified"}, {"predictor", predictor}});
+    auto integ = make("em-exact", dt, {{"newton", "modified"}, {"predictor", predictor}, {"certify", "floor"}});
     integ->initialize(*p.model, s);
     for (int k = 1; k <= 3000; ++k) rep->accumulate(integ->advance(*p.model, s, k * dt));
   }
@@ -279,7 +281,7 @@ TEST(EmExact, DirectorAccelerationInThePredictorSavesIterations) {
 TEST(EmExact, RenewalRefreshKeepsTheBalances) {
   // With refresh 0.1 (as the panel's case file) and Δt 0.001 the plate keeps K̄ over many steps, so the
   // renewal rule has refreshes to add.
-  const std::vector<std::pair<std::string, std::string>> modified = {{"newton", "modified"}, {"refresh", "0.1"}};
+  const std::vector<std::pair<std::string, std::string>> modified = {{"newton", "modified"}, {"refresh", "0.1"}, {"certify", "floor"}};
   auto renewal = modified;
   renewal.emplace_back("refresh_cost", "12");
   const Flight base = fly("em-exact", 1e6, 0.001, 400, kV0, kW, 0.5, modified);
@@ -421,6 +423,28 @@ TEST(EmExact, ReportedInvariantsUseTheEmbeddedVelocities) {
   EXPECT_NE(K_embedded, K_q);
   s.pdot.resize(5);
   EXPECT_THROW(model->invariants(s), std::invalid_argument);
+}
+
+// certify = auto (the default) is resolved when the system is known, and settings() (run.json) reports the
+// result: residual with full Newton, predicted with modified Newton, floor with prescribed displacements
+// (PrescribedMotion.EnergyBalanceClosesWithThePrescribedWork runs that case; theory §5.8).
+TEST(EmExact, CertifyAutoIsResolvedAtInitialize) {
+  auto certify_of = [](const Integrator& integ) {
+    for (const auto& [key, value] : integ.settings())
+      if (key == "certify") return value;
+    return std::string("(none)");
+  };
+  for (const auto& [newton, expected] : {std::pair<std::string, std::string>{"full", "residual"}, {"modified", "predicted"}}) {
+    auto model = free_plate(2.0, 1.0, 2, 1, ShellMaterial{1e6, 0.3, 1.0, 0.1});
+    State s = model->initial_state();
+    auto integ = make("em-exact", 0.01, {{"newton", newton}});
+    EXPECT_EQ(certify_of(*integ), "auto");
+    integ->initialize(*model, s);
+    EXPECT_EQ(certify_of(*integ), expected) << newton;
+    auto given = make("em-exact", 0.01, {{"newton", newton}, {"certify", "floor"}});
+    given->initialize(*model, s);
+    EXPECT_EQ(certify_of(*given), "floor") << newton;
+  }
 }
 
 TEST(EmExact, RejectsBadSettingsAndOtherSystems) {
