@@ -137,6 +137,7 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
     // certify = floor: the floors of the recent steps (the next step's acceptance depends on them).
     for (long j = 0; j < kFloorSteps; ++j) c.scalars["floor_" + std::to_string(j)] = recent_floor_[static_cast<size_t>(j)];
     c.vectors["director_acceleration"] = wdot_;  // the predictor's ẇ_n (theory §5.7)
+    c.scalars["certify_rule"] = predicted_ ? 2.0 : certify_floor_ ? 1.0 : 0.0;  // 0 residual, 1 floor, 2 predicted
     kept_.save(c, *newton_, nopt_.modified);
   }
 
@@ -171,6 +172,17 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
     else
       wdot_.setZero(3 * nn_);
     kept_.restore(c, *newton_, nopt_.modified, sys, "em-exact");
+    // certify = auto with modified Newton: a resumed run keeps the rule it started with (theory §5.8). A
+    // checkpoint without the record was written when auto meant floor (before the fifteenth session). Both
+    // rules skip the accepted iterate's residual, so the solver initialize() built serves either.
+    if (certify_ == "auto" && certify_floor_) {
+      const double rule = c.scalars.count("certify_rule") ? c.scalar("certify_rule") : 1.0;
+      if (rule == 1.0 || rule == 2.0) {
+        predicted_ = (rule == 2.0);
+        for (auto& kv : resolved_)
+          if (kv.first == "certify") kv.second = predicted_ ? "predicted" : "floor";
+      }
+    }
   }
 
   void initialize(SemiDiscreteSystem& sys, State& s) override {

@@ -349,6 +349,9 @@ RunSummary run_dynamic(Problem& problem, const RunOptions& o) {
       throw std::runtime_error("the checkpoint does not fit this case's model (" + std::to_string(state.u.size()) + " DOFs)");
     model.adopt_charts(state.charts);
     integrator->restore(model, state, resume->integrator_data);
+    // A restore may settle a setting too (em-exact's certify = auto keeps the rule the run started with).
+    sum.settings = integrator->settings();
+    spec.integrator.settings = sum.settings;
     DriverNumbers{sum, have_ref, out_index, k_next, E_seen}.each([&](const char* key, double& x) { x = resume->number(key); });
     L_ref = resume->vector("L_ref");
     J_ref = resume->vector("J_ref");

@@ -125,9 +125,11 @@ TEST(Checkpoint, NewIntegratorsCompileUnchangedAndSayWhatIsMissing) {
 
 // Runs `name` on a fast-spinning plate that switches director charts, uninterrupted to t2 and, in a
 // second run, stopped after `stop_after` steps of the interval (t1, t2] (a stop request as SIGINT makes),
-// saved through a checkpoint FILE into a fresh model and integrator, and continued to t2.
+// saved through a checkpoint FILE into a fresh model and integrator, and continued to t2. The continuing
+// integrator is made with `resume_settings` if given (as `shelldyn resume` makes it from the command line).
 void expect_bitwise_continuation(const std::string& name, std::vector<std::pair<std::string, std::string>> settings,
-                                 int stop_after, double dt = 0.01, bool require_switches = true) {
+                                 int stop_after, double dt = 0.01, bool require_switches = true,
+                                 const std::vector<std::pair<std::string, std::string>>* resume_settings = nullptr) {
   const double t1 = 20 * dt, t2 = 50 * dt;
   auto run_a = [&](std::unique_ptr<Model>& model) {
     IntegratorSettings s(name, settings);
@@ -169,7 +171,7 @@ void expect_bitwise_continuation(const std::string& name, std::vector<std::pair<
   // Run B, part 2: everything new, as `shelldyn resume` has it.
   const Checkpoint c = read_checkpoint(path);
   auto model = spin_plate(1e4);
-  IntegratorSettings s(name, settings);
+  IntegratorSettings s(name, resume_settings ? *resume_settings : settings);
   auto integ = make_integrator(s, dt);
   State st = model->initial_state();
   integ->initialize(*model, st);
@@ -292,6 +294,38 @@ TEST(CheckpointEmExact, ModifiedNewtonContinuesBitwiseAtEveryRefreshPhase) {
 TEST(CheckpointEmExact, PredictedCertifyContinuesBitwise) {
   for (int stop_after : {1, 11, 12, 13})
     expect_bitwise_continuation("em-exact", {{"newton", "modified"}, {"certify", "predicted"}}, stop_after);
+}
+
+// certify = auto (theory §5.8): a resumed run keeps the rule it started with. A run begun with certify = floor
+// (what auto meant before the fifteenth session) and resumed without the setting continues bitwise as floor,
+// and says so in its settings (run.json); a checkpoint without the record is read as floor.
+TEST(CheckpointEmExact, CertifyAutoKeepsTheRuleTheRunStartedWith) {
+  const std::vector<std::pair<std::string, std::string>> floor = {{"newton", "modified"}, {"certify", "floor"}};
+  const std::vector<std::pair<std::string, std::string>> automatic = {{"newton", "modified"}};
+  for (int stop_after : {1, 12}) expect_bitwise_continuation("em-exact", floor, stop_after, 0.01, true, &automatic);
+  auto certify_after_restore = [&](const std::vector<std::pair<std::string, std::string>>& begun, bool drop_record) {
+    auto model = spin_plate(1e4);
+    IntegratorSettings s0("em-exact", begun);
+    auto first = make_integrator(s0, 0.01);
+    State st = spin_state(*model, Vec3(3.0, 0.4, 0.2));
+    first->initialize(*model, st);
+    first->advance(*model, st, 0.05);
+    IntegratorCheckpoint c;
+    first->save(c);
+    if (drop_record) c.scalars.erase("certify_rule");
+    IntegratorSettings s1("em-exact", automatic);
+    auto second = make_integrator(s1, 0.01);
+    State fresh = model->initial_state();
+    second->initialize(*model, fresh);
+    second->restore(*model, st, c);
+    for (const auto& [key, value] : second->settings())
+      if (key == "certify") return value;
+    return std::string("(none)");
+  };
+  EXPECT_EQ(certify_after_restore(floor, false), "floor");
+  EXPECT_EQ(certify_after_restore(floor, true), "floor");
+  EXPECT_EQ(certify_after_restore(automatic, false), "predicted");
+  EXPECT_EQ(certify_after_restore(automatic, true), "floor");  // an old checkpoint: auto meant floor
 }
 
 // The renewal refresh (refresh_cost, theory §5.5) counts steps and iterations since the last refresh of K̄: the
