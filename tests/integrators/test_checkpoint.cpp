@@ -225,26 +225,40 @@ TEST(CheckpointNewmark, EmGalphaModifiedNewtonAtEveryRefreshPhase) {
     expect_bitwise_continuation("em-galpha", {{"newton", "modified"}, {"setup_every", "2"}}, stop_after);
 }
 
+using Settings = std::vector<std::pair<std::string, std::string>>;
+
+// Runs `integrator` with `begun` over 5 steps of a spinning plate, saves it, lets `edit` change the checkpoint,
+// and restores that into a fresh integrator made with `resumed`, which it returns (restore() may throw).
+std::unique_ptr<Integrator> resumed_after_five_steps(Model& model, const std::string& integrator, const Settings& begun,
+                                                     const Settings& resumed,
+                                                     const std::function<void(IntegratorCheckpoint&)>& edit) {
+  IntegratorSettings s0(integrator, begun);
+  auto first = make_integrator(s0, 0.01);
+  State st = spin_state(model, Vec3(3.0, 0.4, 0.2));
+  first->initialize(model, st);
+  first->advance(model, st, 0.05);
+  IntegratorCheckpoint c;
+  first->save(c);
+  edit(c);
+  IntegratorSettings s1(integrator, resumed);
+  auto second = make_integrator(s1, 0.01);
+  State fresh = model.initial_state();
+  second->initialize(model, fresh);
+  second->restore(model, st, c);
+  return second;
+}
+
 // Saves `integrator` (modified Newton) after 5 steps of a spinning plate, lets `damage` change the checkpoint as a
 // damaged file would, and expects restore() to refuse it with a runtime_error that names `key`.
 void expect_damaged_checkpoint_refused(const std::string& integrator, const std::string& key,
                                        const std::function<void(IntegratorCheckpoint&)>& damage) {
   auto model = spin_plate(1e4);
-  IntegratorSettings settings(integrator, {{"newton", "modified"}});
-  auto integ = make_integrator(settings, 0.01);
-  State st = spin_state(*model, Vec3(3.0, 0.4, 0.2));
-  integ->initialize(*model, st);
-  integ->advance(*model, st, 0.05);
-  IntegratorCheckpoint c;
-  integ->save(c);
-  ASSERT_EQ(c.vectors.count(key), 1u) << key;
-  damage(c);
-  IntegratorSettings settings2(integrator, {{"newton", "modified"}});
-  auto fresh = make_integrator(settings2, 0.01);
-  State s2 = model->initial_state();
-  fresh->initialize(*model, s2);
+  const Settings modified = {{"newton", "modified"}};
   try {
-    fresh->restore(*model, st, c);
+    resumed_after_five_steps(*model, integrator, modified, modified, [&](IntegratorCheckpoint& c) {
+      ASSERT_EQ(c.vectors.count(key), 1u) << key;
+      damage(c);
+    });
     FAIL() << "a damaged " << key << " was accepted";
   } catch (const std::runtime_error& e) {
     EXPECT_NE(std::string(e.what()).find(key), std::string::npos) << e.what();
@@ -303,21 +317,11 @@ TEST(CheckpointEmExact, CertifyAutoKeepsTheRuleTheRunStartedWith) {
   const std::vector<std::pair<std::string, std::string>> floor = {{"newton", "modified"}, {"certify", "floor"}};
   const std::vector<std::pair<std::string, std::string>> automatic = {{"newton", "modified"}};
   for (int stop_after : {1, 12}) expect_bitwise_continuation("em-exact", floor, stop_after, 0.01, true, &automatic);
-  auto certify_after_restore = [&](const std::vector<std::pair<std::string, std::string>>& begun, bool drop_record) {
+  auto certify_after_restore = [&](const Settings& begun, bool drop_record) {
     auto model = spin_plate(1e4);
-    IntegratorSettings s0("em-exact", begun);
-    auto first = make_integrator(s0, 0.01);
-    State st = spin_state(*model, Vec3(3.0, 0.4, 0.2));
-    first->initialize(*model, st);
-    first->advance(*model, st, 0.05);
-    IntegratorCheckpoint c;
-    first->save(c);
-    if (drop_record) c.scalars.erase("certify_rule");
-    IntegratorSettings s1("em-exact", automatic);
-    auto second = make_integrator(s1, 0.01);
-    State fresh = model->initial_state();
-    second->initialize(*model, fresh);
-    second->restore(*model, st, c);
+    const auto second = resumed_after_five_steps(*model, "em-exact", begun, automatic, [&](IntegratorCheckpoint& c) {
+      if (drop_record) c.scalars.erase("certify_rule");
+    });
     for (const auto& [key, value] : second->settings())
       if (key == "certify") return value;
     return std::string("(none)");
