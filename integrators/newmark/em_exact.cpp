@@ -177,11 +177,7 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
     // rules skip the accepted iterate's residual, so the solver initialize() built serves either.
     if (certify_ == "auto" && certify_floor_) {
       const double rule = c.scalars.count("certify_rule") ? c.scalar("certify_rule") : 1.0;
-      if (rule == 1.0 || rule == 2.0) {
-        predicted_ = (rule == 2.0);
-        for (auto& kv : resolved_)
-          if (kv.first == "certify") kv.second = predicted_ ? "predicted" : "floor";
-      }
+      if (rule == 1.0 || rule == 2.0) use_certify(rule == 2.0 ? "predicted" : "floor");
     }
   }
 
@@ -196,14 +192,10 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
     const Index n = sys.num_dofs();
     nn_ = model_->mesh().num_nodes();
     // certify = auto (constructor): resolved here, where the system is known; run.json records the result.
-    std::string certify = certify_;
-    if (certify == "auto")
-      certify = !nopt_.modified ? "residual" : sys.has_prescribed_motion() ? "floor" : "predicted";
-    certify_floor_ = (certify != "residual");
-    predicted_ = (certify == "predicted");
-    nopt_.skip_final_residual = certify_floor_;
-    for (auto& kv : resolved_)
-      if (kv.first == "certify") kv.second = certify;  // a valid value: run.json's integrator block reruns as is
+    use_certify(certify_ != "auto"        ? certify_
+                : !nopt_.modified             ? "residual"
+                : sys.has_prescribed_motion() ? "floor"
+                                              : "predicted");
     newton_ = std::make_unique<NewtonSolver>(sys.pattern(), nopt_);
     full_newton_.reset();
     M_ = model_->make_matrix();
@@ -246,6 +238,17 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
   }
 
  private:
+  // The floor rule in use (theory §5.3–5.4, §5.8): its flags, the solver option (read when initialize() builds the
+  // solver; floor and predicted both skip the accepted iterate's residual) and the value settings() reports, a
+  // valid setting, so that run.json's integrator block reruns as is.
+  void use_certify(const std::string& rule) {
+    certify_floor_ = (rule != "residual");
+    predicted_ = (rule == "predicted");
+    nopt_.skip_final_residual = certify_floor_;
+    for (auto& kv : resolved_)
+      if (kv.first == "certify") kv.second = rule;
+  }
+
   void step_with_cuts(State& s, double h, int depth, StepReport& rep) {
     std::string why;
     if (step(s, h, rep, &why)) return;

@@ -314,8 +314,8 @@ TEST(CheckpointEmExact, PredictedCertifyContinuesBitwise) {
 // (what auto meant before the fifteenth session) and resumed without the setting continues bitwise as floor,
 // and says so in its settings (run.json); a checkpoint without the record is read as floor.
 TEST(CheckpointEmExact, CertifyAutoKeepsTheRuleTheRunStartedWith) {
-  const std::vector<std::pair<std::string, std::string>> floor = {{"newton", "modified"}, {"certify", "floor"}};
-  const std::vector<std::pair<std::string, std::string>> automatic = {{"newton", "modified"}};
+  const Settings floor = {{"newton", "modified"}, {"certify", "floor"}};
+  const Settings automatic = {{"newton", "modified"}};
   for (int stop_after : {1, 12}) expect_bitwise_continuation("em-exact", floor, stop_after, 0.01, true, &automatic);
   auto certify_after_restore = [&](const Settings& begun, bool drop_record) {
     auto model = spin_plate(1e4);

@@ -89,10 +89,9 @@ const Eigen::Vector3d kV0(0.1, 0.0, 0.2), kW(0.3, 0.5, 1.0);
 // With the correction off the gap is the scheme's own error (8.6e-8 on the free plate).
 double round_off_bound(const Flight& r) { return 4.0 * 2.2e-16 * static_cast<double>(std::max(r.steps, 1L)); }
 
-void print(const std::string& what_s, const Flight& r) {
-  const char* what = what_s.c_str();
+void print(const std::string& what, const Flight& r) {
   std::printf("%-42s max|dH|/H %.2e  max|dL|/|L| %.2e  max|dJ|/|J| %.2e  strain/H %.2e  %.2f it/step  %ld switches  res %.1e\n",
-              what, r.max_dH, r.max_dL, r.max_dJ, r.max_strain, double(r.iterations) / std::max(r.steps, 1L), r.switches,
+              what.c_str(), r.max_dH, r.max_dL, r.max_dJ, r.max_strain, double(r.iterations) / std::max(r.steps, 1L), r.switches,
               r.max_residual);
 }
 
