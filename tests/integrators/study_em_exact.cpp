@@ -74,7 +74,7 @@ TEST(EmExactStudy, DISABLED_FreePlate20s) {
     }
 }
 
-// benchmarks.md §6 plate (E 1e8, 4×2) with spin ω0; 200 s.
+// docs/benchmarks.md §6 plate (E 1e8, 4×2) with spin ω0; 200 s.
 Long spin(const Eigen::Vector3d& w, double dt, const char* label, const char* name = "em-exact",
           std::vector<std::pair<std::string, std::string>> settings = {}) {
   auto model = free_plate(2.0, 1.0, 4, 2, ShellMaterial{1e8, 0.3, 1.0, 0.1});
@@ -132,7 +132,7 @@ TEST(EmExactStudy, DISABLED_TumblingPlate200sModifiedNewton) {
 }
 
 // The other cases under modified Newton with its default certify (predicted, §5.8), the way the
-// benchmark apps run em-exact: §7.12 plate 20 s at three Δt, the stiff free flight (E = 1e9, Δt 0.02, 4 s),
+// benchmark apps run em-exact: the docs/theory.md §7.12 plate 20 s at three Δt, the stiff free flight (E = 1e9, Δt 0.02, 4 s),
 // the tumbling plate at Δt 0.02 and the spins R1, R2 over 200 s. Same bounds as the full-Newton runs above.
 TEST(EmExactStudy, DISABLED_ModifiedNewtonDefaultOtherCases) {
   const std::vector<std::pair<std::string, std::string>> modified = {{"newton", "modified"}};
