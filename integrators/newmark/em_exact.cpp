@@ -3,6 +3,7 @@
 #include "integrators/newmark/em_exact.hpp"
 
 #include "elements/exact_energy.hpp"
+#include "integrators/newmark/consistent_acceleration.hpp"
 #include "integrators/newmark/kept_iteration_matrix.hpp"
 #include "integrators/nonlinear/newton_solver.hpp"
 #include "lib/assembler.hpp"
@@ -52,13 +53,15 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
     nopt_.linear_solver = s.get("linear_solver", "cholmod");
     // Predictor (theory §5, §5.7): u_n, or with modified Newton the trapezoidal extrapolation d_n + Δt v_n + Δt²/2 a_n,
     // p_n + Δt w_n + Δt²/2 ẇ_n with the last step's accelerations a_n = Δv/Δt, ẇ_n = Δw/Δt ("trapezoidal"), or
-    // without the director term ("trapezoidal-v", the predictor before the fourteenth session). A failed step is
-    // retried from u_n with full Newton.
+    // without the director term ("trapezoidal-v", the predictor before the fourteenth session), or with the end-point
+    // accelerations of Newmark's trapezoidal recursion a_{n+1} = 2Δv/Δt − a_n, started from the consistent initial
+    // acceleration ("newmark": em-galpha's predictor, theory §5.9). A failed step is retried from u_n with full Newton.
     const std::string predictor = s.get("predictor", nopt_.modified ? "trapezoidal" : "none");
-    if (predictor != "none" && predictor != "trapezoidal" && predictor != "trapezoidal-v")
-      throw std::invalid_argument("em-exact.predictor: '" + predictor + "' (use none, trapezoidal or trapezoidal-v)");
+    if (predictor != "none" && predictor != "trapezoidal" && predictor != "trapezoidal-v" && predictor != "newmark")
+      throw std::invalid_argument("em-exact.predictor: '" + predictor + "' (use none, trapezoidal, trapezoidal-v or newmark)");
     predictor_ = (predictor != "none");
-    director_acceleration_ = (predictor == "trapezoidal");
+    director_acceleration_ = (predictor == "trapezoidal" || predictor == "newmark");
+    newmark_predictor_ = (predictor == "newmark");
     make_linear_solver(nopt_.linear_solver);
     nopt_.single_precision_solves =  // float copy of the kept factor (docs/dependencies.md §5.5)
         single_precision_setting(s.get("solve_precision", "double"), nopt_.linear_solver, "em-exact");
@@ -137,6 +140,10 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
     // certify = floor: the floors of the recent steps (the next step's acceptance depends on them).
     for (long j = 0; j < kFloorSteps; ++j) c.scalars["floor_" + std::to_string(j)] = recent_floor_[static_cast<size_t>(j)];
     c.vectors["director_acceleration"] = wdot_;  // the predictor's ẇ_n (theory §5.7)
+    if (newmark_predictor_) {  // predictor = newmark: the recursion's end-point accelerations (theory §5.9)
+      c.vectors["newmark_acceleration"] = an_;
+      c.vectors["newmark_director_acceleration"] = wan_;
+    }
     c.scalars["certify_rule"] = predicted_ ? 2.0 : certify_floor_ ? 1.0 : 0.0;  // 0 residual, 1 floor, 2 predicted
     kept_.save(c, *newton_, nopt_.modified);
   }
@@ -171,6 +178,14 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
       wdot_ = c.vector("director_acceleration", 3 * nn_);
     else
       wdot_.setZero(3 * nn_);
+    // predictor = newmark: the recursion's accelerations; a checkpoint without them (written with another predictor)
+    // restarts the recursion from the consistent acceleration of the restored state (not bitwise, theory §5.9).
+    if (newmark_predictor_ && c.vectors.count("newmark_acceleration") && c.vectors.count("newmark_director_acceleration")) {
+      an_ = c.vector("newmark_acceleration", 3 * nn_);
+      wan_ = c.vector("newmark_director_acceleration", 3 * nn_);
+    } else if (newmark_predictor_) {
+      start_newmark_recursion(s);
+    }
     kept_.restore(c, *newton_, nopt_.modified, sys, "em-exact");
     // certify = auto with modified Newton: a resumed run keeps the rule it started with (theory §5.8). A
     // checkpoint without the record was written when auto meant floor (before the fifteenth session). Both
@@ -201,7 +216,7 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
     M_ = model_->make_matrix();
     K_ = M_;
     for (Eigen::VectorXd* v : {&un_, &umid_, &fint_, &r_, &last_u_}) v->setZero(n);
-    for (Eigen::VectorXd* v : {&wdot_, &vn_, &wn_, &pn_, &p1_, &pmid_, &v1_, &w1_, &dv_, &dw_, &mv_, &mw_, &fd_, &g_}) v->setZero(3 * nn_);
+    for (Eigen::VectorXd* v : {&wdot_, &an_, &wan_, &vn_, &wn_, &pn_, &p1_, &pmid_, &v1_, &w1_, &dv_, &dw_, &mv_, &mw_, &fd_, &g_}) v->setZero(3 * nn_);
     work_ = prescribed_work_ = 0.0;
     recent_floor_.fill(0.0);
     renew_steps_ = renew_iterations_ = 0;
@@ -216,6 +231,7 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
       }
     }
     if (s.a.size() != n) s.a.setZero(n);
+    if (newmark_predictor_) start_newmark_recursion(s);
     k0_.clear();
     if (xi_ > 0.0) {
       k0_.resize(static_cast<size_t>(model_->mesh().num_elements()));
@@ -286,6 +302,20 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
   // The ring slot of the step about to be taken.
   size_t floor_slot() const {
     return static_cast<size_t>((predicted_ && steps_ >= kFloorSteps ? steps_ / kFloorSteps : steps_) % kFloorSteps);
+  }
+
+  // predictor = newmark (theory §5.9): the recursion starts from the acceleration that satisfies the equations
+  // of motion at s (em-galpha's start-up, docs/theory.md §6.4): a = the translational entries, ẇ = A1 q̈ + A2(q, q̇).
+  void start_newmark_recursion(const State& s) {
+    Eigen::VectorXd a;
+    consistent_acceleration(*model_, s, nopt_.linear_solver, a);
+    for (int i = 0; i < nn_; ++i) {
+      const Index k = DofMap::dof(i, 0);
+      const DirectorChart& ch = s.charts[static_cast<size_t>(i)];
+      const Eigen::Vector2d q = s.u.segment<2>(k + 3), qd = s.v.segment<2>(k + 3);
+      an_.segment<3>(3 * i) = a.segment<3>(k);
+      wan_.segment<3>(3 * i) = director_A1(q, ch) * a.segment<2>(k + 3) + director_A2(q, qd, ch);
+    }
   }
 
   // Directors p(q) of all nodes (3 per node) in the step's charts.
@@ -446,9 +476,11 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
     if (predictor_ && !full_newton) {  // trapezoidal extrapolation (constructor); directors through their chart
       for (int i = 0; i < nn_; ++i) {
         const Index k = DofMap::dof(i, 0);
-        u.segment<3>(k) += h * vn_.segment<3>(3 * i) + (0.5 * h * h) * s.a.segment<3>(k);
+        const Vec3 a = newmark_predictor_ ? Vec3(an_.segment<3>(3 * i)) : Vec3(s.a.segment<3>(k));
+        u.segment<3>(k) += h * vn_.segment<3>(3 * i) + (0.5 * h * h) * a;
         Vec3 p = pn_.segment<3>(3 * i) + h * wn_.segment<3>(3 * i);
-        if (director_acceleration_) p += (0.5 * h * h) * wdot_.segment<3>(3 * i);
+        if (director_acceleration_)
+          p += (0.5 * h * h) * (newmark_predictor_ ? Vec3(wan_.segment<3>(3 * i)) : Vec3(wdot_.segment<3>(3 * i)));
         u.segment<2>(k + 3) = chart_coordinates(p.normalized(), charts[static_cast<size_t>(i)]);
       }
       for (Index d : sys.dofs().constrained_dofs()) u[d] = un_[d];  // constrained entries stay bitwise u_n
@@ -528,6 +560,11 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
       prescribed_work_ += (mv_[3 * i + c] + fint_[dof] - fd_[3 * i + c]) * (u[dof] - un_[dof]);
     }
     wdot_ = (w1_ - wn_) / h;  // Δw/Δt: the q̈ entries below, and ẇ_n of the next step's predictor (theory §5.7)
+    if (newmark_predictor_) {  // theory §5.9: a_{n+1} = 2 Δv/Δt − a_n, ẇ_{n+1} = 2 Δw/Δt − ẇ_n (exact for any Δt)
+      for (int i = 0; i < nn_; ++i)
+        an_.segment<3>(3 * i) = (2.0 / h) * (v1_.segment<3>(3 * i) - vn_.segment<3>(3 * i)) - an_.segment<3>(3 * i);
+      wan_ = 2.0 * wdot_ - wan_;
+    }
     // New state: v, w from the trapezoidal relations; q̇ and q̈ entries hold the chart's minor components of
     // w and Δw/Δt (for output only: the scheme's state is (d, p, v, w)); a_d = Δv/Δt.
     for (int i = 0; i < nn_; ++i) {
@@ -576,7 +613,9 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
   // The last step's director accelerations (w_{n+1} − w_n)/Δt in ℝ³ (3 per node; 0 before the first step): the
   // predictor's ẇ_n. Chart-free, so a chart switch between steps does not touch it; saved in checkpoints.
   Eigen::VectorXd wdot_;
-  bool director_acceleration_ = false;  // predictor = trapezoidal (theory §5.7)
+  bool director_acceleration_ = false;  // predictor = trapezoidal or newmark (theory §5.7)
+  bool newmark_predictor_ = false;      // predictor = newmark (theory §5.9)
+  Eigen::VectorXd an_, wan_;            // its end-point accelerations a_n, ẇ_n (3 per node, ℝ³)
   Eigen::VectorXd un_, umid_, fint_, r_, last_u_, last_r_, uscale_;
   Eigen::VectorXd vn_, wn_, pn_, p1_, pmid_, v1_, w1_, dv_, dw_, mv_, mw_, fd_, g_;
   double work_ = 0.0, prescribed_work_ = 0.0;

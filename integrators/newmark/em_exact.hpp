@@ -14,8 +14,9 @@
 //   newton full|modified [full], refresh [0.03 with modified Newton, else 0: refresh K̄ when the observed
 //   contraction exceeds it], refresh_cost [0: off; opt-in renewal rule, also refresh K̄ when a step's iterations
 //   exceed the average since the last refresh with the refresh counted as this many iterations, theory §5.5],
-//   setup_every [20; 1e6 when refresh > 0], predictor none|trapezoidal|trapezoidal-v [trapezoidal with modified
-//   Newton, else none; trapezoidal-v leaves out the directors' acceleration term, theory §5.7], linear_solver [cholmod], solve_precision [double] (or single: float copy
+//   setup_every [20; 1e6 when refresh > 0], predictor none|trapezoidal|trapezoidal-v|newmark [trapezoidal with
+//   modified Newton, else none; trapezoidal-v leaves out the directors' acceleration term, theory §5.7; newmark
+//   takes the end-point accelerations of Newmark's recursion, em-galpha's predictor, theory §5.9], linear_solver [cholmod], solve_precision [double] (or single: float copy
 //   of the factor, docs/dependencies.md §5.5), res_tol [1e-12], stall_tol [1e-6], stall_ratio [0.5],
 //   stall_step [1e-6], max_iters [25], max_cuts [0], hysteresis [1], certify auto|residual|floor|predicted [auto:
 //   with modified Newton predicted, or floor when the system prescribes displacements (theory §5.8); else

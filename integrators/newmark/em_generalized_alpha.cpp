@@ -1,5 +1,6 @@
 #include "integrators/newmark/em_generalized_alpha.hpp"
 
+#include "integrators/newmark/consistent_acceleration.hpp"
 #include "integrators/newmark/kept_iteration_matrix.hpp"
 #include "integrators/nonlinear/newton_solver.hpp"
 #include "lib/assembler.hpp"
@@ -182,21 +183,11 @@ class NewmarkFamily final : public Integrator {
       v->setZero(n);
     work_ = damping_work_ = prescribed_work_ = 0.0;
     sys.rechart(s, hysteresis_);
-    // Consistent initial acceleration (docs/theory.md §6.4 start-up): M(u0) a0 = F_ext − F_int − F_m.
-    sys.mass(s.u, s.charts, M_);
-    sys.internal(s.u, s.charts, fint_.data(), nullptr);
-    sys.inertial(s.u, s.v, s.charts, fm_.data());
-    sys.external(s.t, s.u, s.charts, fext_.data());
-    tmp_ = fext_ - fint_ - fm_;
-    apply_dirichlet(sys.dofs(), M_, tmp_.data());
     {
       const Invariants inv = sys.invariants(s);
       energy0_ = std::abs(inv.kinetic) + std::abs(inv.strain);
     }
-    auto solver = make_linear_solver(nopt_.linear_solver);
-    solver->factorize(M_.view());
-    s.a.resize(n);
-    solver->solve(tmp_.data(), s.a.data());
+    consistent_acceleration(sys, s, nopt_.linear_solver, s.a);  // docs/theory.md §6.4 start-up
   }
 
   StepReport advance(SemiDiscreteSystem& sys, State& s, double t_out) override {

@@ -310,6 +310,25 @@ TEST(CheckpointEmExact, PredictedCertifyContinuesBitwise) {
     expect_bitwise_continuation("em-exact", {{"newton", "modified"}, {"certify", "predicted"}}, stop_after);
 }
 
+// predictor = newmark (theory §5.9) carries the end-point accelerations of its recursion, which every later
+// predictor depends on: saved, the run continues bitwise. A checkpoint written with another predictor has no
+// such vectors; resumed with newmark, the recursion restarts from the consistent acceleration of the restored
+// state (finite, saved again at the next checkpoint) instead of failing.
+TEST(CheckpointEmExact, NewmarkPredictorContinuesBitwise) {
+  const Settings newmark = {{"newton", "modified"}, {"predictor", "newmark"}};
+  for (int stop_after : {1, 12}) expect_bitwise_continuation("em-exact", newmark, stop_after);
+  auto model = spin_plate(1e4);
+  const Settings trapezoidal = {{"newton", "modified"}};
+  const auto second = resumed_after_five_steps(*model, "em-exact", trapezoidal, newmark, [](IntegratorCheckpoint& c) {
+    EXPECT_EQ(c.vectors.count("newmark_acceleration"), 0u);
+  });
+  IntegratorCheckpoint again;
+  second->save(again);
+  const Index nn = model->mesh().num_nodes();
+  EXPECT_GT(again.vector("newmark_acceleration", 3 * nn).norm(), 0.0);  // a spinning plate's nodes accelerate
+  EXPECT_GT(again.vector("newmark_director_acceleration", 3 * nn).norm(), 0.0);
+}
+
 // certify = auto (theory §5.8): a resumed run keeps the rule it started with. A run begun with certify = floor
 // (what auto meant before the fifteenth session) and resumed without the setting continues bitwise as floor,
 // and says so in its settings (run.json); a checkpoint without the record is read as floor.
