@@ -104,6 +104,15 @@ class Integrator {
   // integrators that do not (integrators/runs/case_integrator.cpp), never run with the DOFs held at 0.
   virtual bool supports_prescribed_motion() const { return false; }
 
+  // The scaled residuals ρ_k = ‖r(u_k)‖∞ / (largest entry of the step's inertial, internal and external forces)
+  // of every iterate a Newton-based step evaluated, reported once per accepted step with the step's Newton
+  // iterations (corrections). When the last correction was accepted without evaluating its residual, the
+  // iterations equal the residuals; otherwise there is one residual more. For studies of the iteration
+  // (bench_step_breakdown --residual-trace; docs/theory/exact-energy-momentum.md §5.9). Returns false if the
+  // integrator does not report them (the default); an empty function switches the report off.
+  using ResidualTrace = std::function<void(const std::vector<double>& scaled, int iterations)>;
+  virtual bool set_residual_trace(ResidualTrace /*trace*/) { return false; }
+
   // Checkpoint/restart. save() is called between advance() calls (or after an advance() that stopped
   // early on a stop request), restore() right after initialize() with the saved State already in
   // `state`. The defaults throw, so a new integrator compiles unchanged and says what is missing.

@@ -17,6 +17,7 @@
 #include <cstdio>
 #include <limits>
 #include <sstream>
+#include <utility>
 
 namespace shelldyn {
 namespace {
@@ -114,6 +115,10 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
   double prescribed_work() const override { return prescribed_work_; }
   bool supports_prescribed_motion() const override { return true; }
   const Data& diagnostics() const override { return diag_; }
+  bool set_residual_trace(ResidualTrace trace) override {
+    residual_trace_ = std::move(trace);
+    return true;
+  }
 
   // Checkpoint (docs/architecture.md "Checkpoints and resume"): the State carries d, v and, in
   // State::pdot, the embedded director velocities w (theory §2), which the step needs exactly; the
@@ -519,6 +524,7 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
       *why = os.str();
       return false;
     }
+    if (residual_trace_) residual_trace_(history, r.iterations);  // ρ_k as the stopping rule sees it (theory §5)
     // The accepted iterate: the last evaluated one, or (certify = floor, floor test) the solver's u_k,
     // accepted before its residual was evaluated.
     const bool evaluated = !certify_floor_ || accept_last_evaluated;
@@ -616,6 +622,7 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
   bool director_acceleration_ = false;  // predictor = trapezoidal or newmark (theory §5.7)
   bool newmark_predictor_ = false;      // predictor = newmark (theory §5.9)
   Eigen::VectorXd an_, wan_;            // its end-point accelerations a_n, ẇ_n (3 per node, ℝ³)
+  ResidualTrace residual_trace_;        // set_residual_trace()
   Eigen::VectorXd un_, umid_, fint_, r_, last_u_, last_r_, uscale_;
   Eigen::VectorXd vn_, wn_, pn_, p1_, pmid_, v1_, w1_, dv_, dw_, mv_, mw_, fd_, g_;
   double work_ = 0.0, prescribed_work_ = 0.0;

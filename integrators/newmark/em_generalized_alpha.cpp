@@ -7,11 +7,13 @@
 #include "lib/linear_solver.hpp"
 #include "lib/profile.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cmath>
 #include <limits>
 #include <sstream>
+#include <utility>
 
 namespace shelldyn {
 
@@ -145,6 +147,10 @@ class NewmarkFamily final : public Integrator {
   double damping_work() const override { return damping_work_; }
   double prescribed_work() const override { return prescribed_work_; }
   bool supports_prescribed_motion() const override { return true; }
+  bool set_residual_trace(ResidualTrace trace) override {
+    residual_trace_ = std::move(trace);
+    return true;
+  }
 
   // Checkpoint (docs/architecture.md "Checkpoints and resume"): besides the State (u, v, a, charts)
   // a step depends on W_ext, the step counter (messages), the last step size (modified Newton
@@ -268,6 +274,7 @@ class NewmarkFamily final : public Integrator {
       }
     };
     bool keep_constrained = false;  // true: the residual keeps its constrained rows (the reactions)
+    std::vector<double> trace;      // scaled residuals of the step's iterates (set_residual_trace())
     auto residual = [&](const double* u, double* r) {
       const Eigen::Map<const Eigen::VectorXd> uu(u, n);
       midpoint_state(u);
@@ -290,6 +297,11 @@ class NewmarkFamily final : public Integrator {
       rr = fm_ + fint_ - fext_;  // = −P̄ (§6.4)
       if (!keep_constrained) zero_constrained(sys.dofs(), r);
       if (!rr.allFinite()) throw std::runtime_error("non-finite residual");
+      if (residual_trace_) {  // set_residual_trace(): ‖r‖∞ over the largest force entry, as em-exact scales it
+        const double scale = std::max({fm_.cwiseAbs().maxCoeff(), fint_.cwiseAbs().maxCoeff(), fext_.cwiseAbs().maxCoeff()});
+        const double rn = rr.cwiseAbs().maxCoeff();
+        trace.push_back(rn == 0.0 ? 0.0 : rn / scale);
+      }
     };
     bool replayed = false;
     // The kept K̄ seen from each iterate's midpoint configuration (docs/theory.md §6.9; modified Newton only).
@@ -368,6 +380,7 @@ class NewmarkFamily final : public Integrator {
       *why = r.message + " (cc = " + std::to_string(r.energy_ratio) + ", iterations = " + std::to_string(r.iterations) + ")";
       return false;
     }
+    if (residual_trace_) residual_trace_(trace, r.iterations);
     if (sys.has_prescribed_motion()) {  // reaction work Σ r_c Δu_c of the prescribed DOFs (docs/theory.md §8.6)
       keep_constrained = true;
       rc_.resize(n);
@@ -413,6 +426,7 @@ class NewmarkFamily final : public Integrator {
   double step_tol_ = 1e-14;
   bool step_refresh_ = false;
   bool newmark_predictor_ = false;
+  ResidualTrace residual_trace_;  // set_residual_trace()
   long steps_ = 0;
   bool floor_estimate_ = false;
   KeptIterationMatrix kept_;  // the modified solver's K̄ across steps and checkpoints
