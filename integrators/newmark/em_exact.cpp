@@ -567,8 +567,7 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
     }
     wdot_ = (w1_ - wn_) / h;  // Δw/Δt: the q̈ entries below, and ẇ_n of the next step's predictor (theory §5.7)
     if (newmark_predictor_) {  // theory §5.9: a_{n+1} = 2 Δv/Δt − a_n, ẇ_{n+1} = 2 Δw/Δt − ẇ_n (exact for any Δt)
-      for (int i = 0; i < nn_; ++i)
-        an_.segment<3>(3 * i) = (2.0 / h) * (v1_.segment<3>(3 * i) - vn_.segment<3>(3 * i)) - an_.segment<3>(3 * i);
+      an_ = (2.0 / h) * dv_ - an_;  // dv_ = v_{n+1} − v_n of the accepted iterate (kinematics() above)
       wan_ = 2.0 * wdot_ - wan_;
     }
     // New state: v, w from the trapezoidal relations; q̇ and q̈ entries hold the chart's minor components of
