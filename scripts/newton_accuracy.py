@@ -22,9 +22,10 @@ The ratio at the schemes' defaults is printed beside it.
 
 Writes into --out (default results/newton-accuracy): newton-accuracy.csv (one row per run), newton-accuracy.md
 (the tables), newton-accuracy.png (iterations per step against the accepted residual, one panel per case; needs
-matplotlib) and traces/ (the per-step residual traces). Runs --jobs at a time (default 2), one thread each; the
-three full cases take about 4 minutes of CPU for em-exact and 10 for the five em-galpha runs on this project's
-machine (--steps N runs the first N steps of every case instead of the full duration).
+matplotlib) and traces/ (the per-step residual traces). Runs --jobs at a time (default 2), one thread each. The
+full runs took 100 s of CPU for the three em-exact runs and 8 minutes for the fifteen em-galpha runs on this
+project's 2-core machine, about 7 minutes of wall time (2026-11-30); --steps N runs the first N steps of every
+case instead of the whole duration.
 """
 import argparse
 import concurrent.futures
@@ -126,8 +127,10 @@ def tables(rows, cases):
               "|---|---|---|---|---|---|"]
     summary = []
     for case in cases:
-        ex = next(r for r in rows if r["case"] == case and r["integrator"] == "em-exact")
-        gd = next(r for r in rows if r["case"] == case and r["integrator"] == "em-galpha" and r["setting"] == "default")
+        ex = next((r for r in rows if r["case"] == case and r["integrator"] == "em-exact"), None)
+        gd = next((r for r in rows if r["case"] == case and r["integrator"] == "em-galpha" and r["setting"] == "default"), None)
+        if ex is None or gd is None:
+            fail(f"{case}: the runs lack em-exact's or em-galpha's default run; rerun without --reuse", 1)
         pts_med = [(r["rho_median"], r["iterations"]) for r in rows if r["case"] == case and r["integrator"] == "em-galpha"]
         pts_p90 = [(r["rho_p90"], r["iterations"]) for r in rows if r["case"] == case and r["integrator"] == "em-galpha"]
         gm, gp = interpolate(pts_med, ex["rho_median"]), interpolate(pts_p90, ex["rho_p90"])
@@ -222,13 +225,16 @@ def measure(a):
 
 
 def main():
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0],
-                                 formatter_class=argparse.RawDescriptionHelpFormatter, epilog=__doc__.split("\n\n", 1)[1])
+    class Formatter(argparse.RawDescriptionHelpFormatter, argparse.ArgumentDefaultsHelpFormatter):
+        pass
+
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0], formatter_class=Formatter,
+                                 epilog=__doc__.split("\n\n", 1)[1])
     ap.add_argument("--build", default=os.path.join(ROOT, "build"), help="build directory with bin/bench_step_breakdown")
-    ap.add_argument("--bench", help="the bench_step_breakdown executable (default: BUILD/bin/bench_step_breakdown)")
+    ap.add_argument("--bench", help="the bench_step_breakdown executable, if not BUILD/bin/bench_step_breakdown")
     ap.add_argument("--out", default=os.path.join(ROOT, "results", "newton-accuracy"), help="output directory")
     ap.add_argument("--cases", nargs="+", default=CASES, choices=CASES, help="benchmark cases (apps/cases/NAME.yaml)")
-    ap.add_argument("--steps", type=int, default=0, help="steps per run (default: each case's full duration)")
+    ap.add_argument("--steps", type=int, default=0, help="steps per run (0: each case's full duration)")
     ap.add_argument("--jobs", type=int, default=2, help="runs at a time (each one thread)")
     ap.add_argument("--e-floors", default="1e-21,1e-22,1e-23,1e-24", help="em-galpha's tighter e_floor values")
     ap.add_argument("--reuse", action="store_true",
