@@ -2,6 +2,7 @@
 
 #include "integrators/newmark/consistent_acceleration.hpp"
 #include "integrators/newmark/kept_iteration_matrix.hpp"
+#include "integrators/nonlinear/energy_floor_test.hpp"
 #include "integrators/nonlinear/newton_solver.hpp"
 #include "lib/assembler.hpp"
 #include "lib/linear_solver.hpp"
@@ -348,21 +349,15 @@ class NewmarkFamily final : public Integrator {
     // Stopping rule of modified Newton (constructor): cc ≤ cc_tol (in NewtonSolver), the energy floor
     // E_k ≤ e_floor·E_sys, or the scaled step test once (round-off reached).
     const double floor = e_floor_ * (energy0_ + std::abs(work_));
-    double e_hist[2] = {0.0, 0.0};  // E_{k−1}, E_{k−2} of this step (floor_test = estimate)
+    // floor_test = estimate (docs/theory.md §6.5): E_k measures the error of u_{k−1}; that of u_k is about the next
+    // correction's energy, estimated from the observed energy contraction (energy_floor_test.hpp).
+    EnergyFloorTest energy_floor(floor, floor_estimate_);
     NewtonSolver::IterationHook hook;
     if (floor > 0.0 || nopt_.modified)
-      hook = [this, floor, n, &newton, &e_hist](int, const double*, const double* du, const double* f) {
+      hook = [this, n, &newton, &energy_floor](int, const double*, const double* du, const double* f) {
         const Eigen::Map<const Eigen::VectorXd> d(du, n), r(f, n);
         const double Ek = std::abs(d.dot(r));  // E_k = |Δu_k·P̄(u_{k−1})| (eq. 39)
-        if (floor > 0.0 && Ek <= floor) return true;
-        // floor_test = estimate (docs/theory.md §6.5): E_k measures the error of u_{k−1}; that of u_k is about
-        // the next correction's energy θ_E E_k, θ_E the observed energy contraction (the larger of the last two
-        // ratios: the first iteration from the predictor contracts faster than the rest), with a margin of 10.
-        if (floor_estimate_ && floor > 0.0 && e_hist[1] > 0.0 &&
-            10.0 * Ek * std::max(Ek / e_hist[0], e_hist[0] / e_hist[1]) <= floor)
-          return true;
-        e_hist[1] = e_hist[0];
-        e_hist[0] = Ek;
+        if (energy_floor.accept(Ek)) return true;
         // Scaled step test |Δu_i| ≤ step_tol max(1, |u_n,i|), met once (modified Newton, see the constructor).
         if (!newton.options().modified || step_refresh_) return false;
         return (d.array().abs() * uscale_.array()).maxCoeff() <= step_tol_;
