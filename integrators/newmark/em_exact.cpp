@@ -5,6 +5,7 @@
 #include "elements/exact_energy.hpp"
 #include "integrators/newmark/consistent_acceleration.hpp"
 #include "integrators/newmark/kept_iteration_matrix.hpp"
+#include "integrators/nonlinear/energy_floor_test.hpp"
 #include "integrators/nonlinear/newton_solver.hpp"
 #include "lib/assembler.hpp"
 #include "lib/linear_solver.hpp"
@@ -89,9 +90,22 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
     // conservation for iterations, measured in §5.4 and §5.8). "auto", the default, is resolved by
     // initialize(): residual with full Newton; with modified Newton predicted, or floor when the system
     // prescribes displacements (their reaction work is taken from the last evaluated force, theory §5.8).
+    // "energy" (theory §5.10) stops by em-galpha's modified-Newton rule instead of at the floor, with its setting names
+    // and defaults: u_k unevaluated once the energy of its correction E_k = |Δu_k·r(u_{k−1})| is below cc_tol·E_1 (eq. 39)
+    // or below e_floor times the energy the body holds, or the estimated energy of the next correction is
+    // (docs/theory.md §6.5), or the correction is at round-off (step_tol). The balances then hold to that tolerance,
+    // not to round-off.
     certify_ = s.get("certify", std::string("auto"));
-    if (certify_ != "auto" && certify_ != "residual" && certify_ != "floor" && certify_ != "predicted")
-      throw std::invalid_argument("em-exact.certify: '" + certify_ + "' (use auto, residual, floor or predicted)");
+    if (certify_ != "auto" && certify_ != "residual" && certify_ != "floor" && certify_ != "predicted" && certify_ != "energy")
+      throw std::invalid_argument("em-exact.certify: '" + certify_ + "' (use auto, residual, floor, predicted or energy)");
+    e_floor_ = s.get("e_floor", 1e-20);
+    if (!(e_floor_ >= 0.0) || !std::isfinite(e_floor_))
+      throw std::invalid_argument("em-exact.e_floor must be >= 0 (certify = energy: the energy floor relative to K + V, 0 = off, "
+                                  "theory §5.10)");
+    cc_tol_ = s.get("cc_tol", 1e-14);  // certify = energy: paper eq. 39's relative test E_k/E_1 (em-galpha's modified default)
+    step_tol_ = s.get("step_tol", 1e-14);  // certify = energy: em-galpha's round-off fallback on the scaled correction
+    if (!(cc_tol_ > 0.0) || !(step_tol_ >= 0.0))
+      throw std::invalid_argument("em-exact: need cc_tol > 0 and step_tol >= 0 (certify = energy, theory §5.10)");
     floor_margin_ = s.get("floor_margin", 1.5);
     predict_factor_ = s.get("predict_factor", 1.0);
     if (!(predict_factor_ > 0.0) || !std::isfinite(predict_factor_))
@@ -149,7 +163,9 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
       c.vectors["newmark_acceleration"] = an_;
       c.vectors["newmark_director_acceleration"] = wan_;
     }
-    c.scalars["certify_rule"] = predicted_ ? 2.0 : certify_floor_ ? 1.0 : 0.0;  // 0 residual, 1 floor, 2 predicted
+    // 0 residual, 1 floor, 2 predicted, 3 energy
+    c.scalars["certify_rule"] = energy_rule_ ? 3.0 : predicted_ ? 2.0 : certify_floor_ ? 1.0 : 0.0;
+    c.scalars["energy0"] = energy0_;  // certify = energy: scale of the floor (initialize() would take the restored state's)
     kept_.save(c, *newton_, nopt_.modified);
   }
 
@@ -173,6 +189,7 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
     diag_.unevaluated_steps = c.scalars.count("diag_unevaluated_steps") ? static_cast<long>(c.scalar("diag_unevaluated_steps")) : 0;
     renew_steps_ = c.scalars.count("renew_steps") ? static_cast<long>(c.scalar("renew_steps")) : 0;
     renew_iterations_ = c.scalars.count("renew_iterations") ? static_cast<long>(c.scalar("renew_iterations")) : 0;
+    if (c.scalars.count("energy0")) energy0_ = c.scalar("energy0");
     for (long j = 0; j < kFloorSteps; ++j) {
       const std::string key = "floor_" + std::to_string(j);
       recent_floor_[static_cast<size_t>(j)] = c.scalars.count(key) ? c.scalar(key) : 0.0;
@@ -236,6 +253,10 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
       }
     }
     if (s.a.size() != n) s.a.setZero(n);
+    {  // K + V at the start, with the embedded w just set: the scale of certify = energy's floor (theory §5.10)
+      const Invariants inv = sys.invariants(s);
+      energy0_ = std::abs(inv.kinetic) + std::abs(inv.strain);
+    }
     if (newmark_predictor_) start_newmark_recursion(s);
     k0_.clear();
     if (xi_ > 0.0) {
@@ -265,6 +286,7 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
   void use_certify(const std::string& rule) {
     certify_floor_ = (rule != "residual");
     predicted_ = (rule == "predicted");
+    energy_rule_ = (rule == "energy");
     nopt_.skip_final_residual = certify_floor_;
     for (auto& kv : resolved_)
       if (kv.first == "certify") kv.second = rule;
@@ -302,8 +324,9 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
     return f[kFloorSteps / 2];
   }
 
-  // Whether the step about to be taken measures the floor (always but with certify = predicted, theory §5.4).
-  bool measures_floor() const { return !predicted_ || steps_ < kFloorSteps || steps_ % kFloorSteps == 0; }
+  // Whether the step about to be taken measures the floor (always but with certify = predicted, theory §5.4; never
+  // with certify = energy, whose steps stop short of the floor and do not use it, theory §5.10).
+  bool measures_floor() const { return !energy_rule_ && (!predicted_ || steps_ < kFloorSteps || steps_ % kFloorSteps == 0); }
   // The ring slot of the step about to be taken.
   size_t floor_slot() const {
     return static_cast<size_t>((predicted_ && steps_ >= kFloorSteps ? steps_ / kFloorSteps : steps_) % kFloorSteps);
@@ -437,12 +460,25 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
     // evaluated iterate u_{k−1} (the one the same tests accept with certify = residual; Δu_k is discarded)
     // and the floor test accepts u_k unevaluated (theory §5, §5.3).
     bool accept_last_evaluated = false;
-    auto hook = [&](int k, const double*, const double* du, const double*) -> bool {
+    // certify = energy (theory §5.10): em-galpha's floor on E_k = |Δu_k·r(u_{k−1})|, relative to the energy held.
+    // Also as em-galpha: the paper's relative test E_k ≤ cc_tol·E_1 from the second correction on (eq. 39), and the
+    // scaled correction max_i |Δu_k,i| / max(1, |u_n,i|) ≤ step_tol (round-off reached).
+    EnergyFloorTest energy_floor(energy_rule_ ? e_floor_ * (energy0_ + std::abs(work_)) : 0.0, true);
+    double energy_first = 0.0;  // E_1
+    auto hook = [&](int k, const double*, const double* du, const double* f) -> bool {
       const double rk = history.back();
       const double step = (Eigen::Map<const Eigen::VectorXd>(du, n).cwiseAbs().array() * uscale_.array()).maxCoeff();
       if (k == 1) first_step = step;
       const double step_before = prev_step;
       prev_step = step;
+      if (energy_rule_) {
+        const double Ek = std::abs(Eigen::Map<const Eigen::VectorXd>(du, n).dot(Eigen::Map<const Eigen::VectorXd>(f, n)));
+        if (k == 1) energy_first = Ek;
+        if ((k > 1 && Ek <= cc_tol_ * energy_first) || energy_floor.accept(Ek) || step <= step_tol_) {
+          accept_last_evaluated = false;  // u_k, unevaluated (as em-galpha accepts it)
+          return true;
+        }
+      }
       accept_last_evaluated = certify_floor_;
       if (rk <= res_tol_) return true;
       double prev_best = std::numeric_limits<double>::infinity();
@@ -600,6 +636,11 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
   std::string certify_;          // the setting: auto, residual, floor or predicted (resolved by initialize())
   bool certify_floor_ = false;  // certify = floor or predicted (theory §5.3)
   bool predicted_ = false;      // certify = predicted (theory §5.4)
+  bool energy_rule_ = false;    // certify = energy (theory §5.10)
+  double e_floor_ = 1e-20;      // its floor relative to energy0_ + |W_ext|
+  double cc_tol_ = 1e-14;       // relative test E_k/E_1
+  double step_tol_ = 1e-14;     // scaled-correction test
+  double energy0_ = 0.0;        // K + V at initialize()
   double floor_margin_ = 1.5;
   double predict_factor_ = 1.0;
   double refresh_cost_ = 0.0;   // renewal rule (theory §5.5); 0 = off

@@ -18,10 +18,11 @@
 //   modified Newton, else none; trapezoidal-v leaves out the directors' acceleration term, theory §5.7; newmark
 //   takes the end-point accelerations of Newmark's recursion, em-galpha's predictor, theory §5.9], linear_solver [cholmod], solve_precision [double] (or single: float copy
 //   of the factor, docs/dependencies.md §5.5), res_tol [1e-12], stall_tol [1e-6], stall_ratio [0.5],
-//   stall_step [1e-6], max_iters [25], max_cuts [0], hysteresis [1], certify auto|residual|floor|predicted [auto:
-//   with modified Newton predicted, or floor when the system prescribes displacements (theory §5.8); else
+//   stall_step [1e-6], max_iters [25], max_cuts [0], hysteresis [1], certify auto|residual|floor|predicted|energy
+//   [auto: with modified Newton predicted, or floor when the system prescribes displacements (theory §5.8); else
 //   residual] and floor_margin [1.5] (theory §5.3), predict_factor [1] (certify = predicted: safety factor on
-//   the predicted residual, theory §5.4),
+//   the predicted residual, theory §5.4), cc_tol [1e-14], e_floor [1e-20], step_tol [1e-14] (certify = energy:
+//   em-galpha's modified-Newton stopping rule, theory §5.10),
 //   correction [true] (false = the paper's force without the §3 correction: for tests that must fail).
 // Checkpoints (docs/architecture.md "Checkpoints and resume"): save/restore continue bitwise, with modified
 // Newton too; a stop request (SIGINT, --max-wall) is honoured at the next step boundary.
@@ -33,6 +34,9 @@
 // seen to be at the floor (§5.3). certify = predicted (modified Newton's default) accepts one correction
 // earlier, once the contraction predicts the floor for the iterate (§5.4, §5.8): fewer iterations, a larger
 // (still round-off-sized, but one-signed) energy error; certify = floor is the choice for long stiff runs.
+// certify = energy (opt-in, §5.10) stops by em-galpha's rule instead (the energy of the correction against the
+// paper's relative test, an absolute floor and its estimate, or a round-off-sized correction): em-galpha's
+// iterations on the benchmarks at a similar energy error there, but 1e-9 to 1e-7 on long runs of stiff bodies.
 #pragma once
 
 #include "integrators/integrator.hpp"

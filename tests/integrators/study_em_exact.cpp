@@ -154,5 +154,32 @@ TEST(EmExactStudy, DISABLED_ModifiedNewtonDefaultOtherCases) {
   }
 }
 
+// certify = energy (docs/theory/exact-energy-momentum.md §5.10): em-galpha's modified-Newton stopping rule on em-exact's
+// step, on every case of the issue. The balances then hold to that rule's tolerance, not to round-off, and the
+// issue's 1e-10 is not met: measured max |ΔH|/H 3.4e-9 / 1.8e-9 / 7.1e-10 (free plate, Δt 0.02 / 0.01 / 0.005),
+// 7.1e-8 (stiff free flight), 6.1e-10 / 9.9e-9 (tumbling, Δt 0.01 / 0.02), 5.5e-10 / 5.3e-10 (R1 / R2); max ‖ΔJ‖/‖J‖
+// up to 2.1e-7 (stiff free flight). The bounds below are those measurements rounded up: a regression check of
+// the quantified behaviour, not the issue's bounds (which certify = residual, floor and predicted meet above).
+TEST(EmExactStudy, DISABLED_CertifyEnergyCases) {
+  const std::vector<std::pair<std::string, std::string>> energy = {{"newton", "modified"}, {"certify", "energy"}};
+  for (const auto& [E, dt, t_end] : {std::tuple<double, double, double>{1e6, 0.02, 20.0}, {1e6, 0.01, 20.0},
+                                     {1e6, 0.005, 20.0}, {1e9, 0.02, 4.0}}) {
+    auto model = free_plate(2.0, 1.0, 2, 1, ShellMaterial{E, 0.3, 1.0, 0.1});
+    State s = model->initial_state();
+    set_free_flight_velocity(*model, s, Eigen::Vector3d(0.1, 0, 0.2), Eigen::Vector3d(0.3, 0.5, 1.0), 0.5);
+    const Long r = long_run(*model, s, "em-exact", dt, t_end, E > 1e6 ? "stiff free flight, energy" : "free plate, energy", energy);
+    EXPECT_LT(r.max_dH, E > 1e6 ? 1e-7 : 5e-9);
+    EXPECT_LT(r.max_dJ, E > 1e6 ? 5e-7 : 5e-9);
+  }
+  for (const auto& [w, dt, label] : {std::tuple<Eigen::Vector3d, double, const char*>{{0.01, 1.0, 0.01}, 0.01, "tumbling, energy"},
+                                     {{0.01, 1.0, 0.01}, 0.02, "tumbling, energy"},
+                                     {{0, 0, 1}, 0.01, "R1, energy"}, {{1, 0, 0}, 0.01, "R2, energy"}}) {
+    const Long r = spin(w, dt, label, "em-exact", energy);
+    EXPECT_LT(r.max_strain, 1e-6);
+    EXPECT_LT(r.max_dH, 2e-8);
+    EXPECT_LT(r.max_dJ, 1e-8);
+  }
+}
+
 }  // namespace
 }  // namespace shelldyn

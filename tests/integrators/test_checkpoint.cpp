@@ -310,6 +310,12 @@ TEST(CheckpointEmExact, PredictedCertifyContinuesBitwise) {
     expect_bitwise_continuation("em-exact", {{"newton", "modified"}, {"certify", "predicted"}}, stop_after);
 }
 
+// certify = energy (theory §5.10): the floor is relative to K + V at the start of the run, which the checkpoint
+// carries; initialize() on the restored state would take that state's energy instead.
+TEST(CheckpointEmExact, EnergyCertifyContinuesBitwise) {
+  for (int stop_after : {1, 12}) expect_bitwise_continuation("em-exact", {{"newton", "modified"}, {"certify", "energy"}}, stop_after);
+}
+
 // predictor = newmark (theory §5.9) carries the end-point accelerations of its recursion, which every later
 // predictor depends on: saved, the run continues bitwise. A checkpoint written with another predictor has no
 // such vectors; resumed with newmark, the recursion restarts from the consistent acceleration of the restored
