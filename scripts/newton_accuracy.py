@@ -9,7 +9,8 @@ at different accuracies: em-exact iterates to the residual's round-off floor (it
 residual), em-galpha stops on its energy test (e_floor). This script measures the comparison at equal accuracy
 (docs/theory/exact-energy-momentum.md §5.9). For every case it runs, with bench_step_breakdown --residual-trace:
 
-  em-exact with the case's settings (modified Newton, `certify = predicted`), and
+  em-exact with the case's settings (modified Newton, `certify = predicted`),
+  em-exact stopped by em-galpha's own rule (`certify = energy`, theory §5.10), and
   em-galpha with its defaults and with tighter energy tests (--e-floors, default 1e-21,1e-22,1e-23,1e-24),
 
 and reads the scaled residual of the accepted iterate of every step from the traces (estimated as
@@ -18,14 +19,14 @@ iterations per step are then interpolated, linearly in log10(residual), at em-ex
 accepted residual, along the runs that no other em-galpha run beats in both iterations and residual (a tighter
 e_floor that only adds iterations at the round-off floor drops out): the ratio of em-exact's iterations to that
 value is the comparison at equal accuracy. Where em-exact's residual lies outside that range, the table says so.
-The ratio at the schemes' defaults is printed beside it.
+The ratio at the schemes' defaults is printed beside it, and so is the ratio when both schemes stop by the same
+rule (em-exact with `certify = energy` against em-galpha's default), which compares the Newton iterations alone.
 
 Writes into --out (default results/newton-accuracy): newton-accuracy.csv (one row per run), newton-accuracy.md
 (the tables), newton-accuracy.png (iterations per step against the accepted residual, one panel per case; needs
 matplotlib) and traces/ (the per-step residual traces). Runs --jobs at a time (default 2), one thread each. The
-full runs took 100 s of CPU for the three em-exact runs and 8 minutes for the fifteen em-galpha runs on this
-project's 2-core machine, about 7 minutes of wall time (2026-11-30); --steps N runs the first N steps of every
-case instead of the whole duration.
+full runs (21) took about 8 minutes of wall time on this project's 2-core machine (2026-11-30); --steps N runs the
+first N steps of every case instead of the whole duration.
 """
 import argparse
 import concurrent.futures
@@ -83,13 +84,13 @@ def run(bench, case_name, steps, integrator, sets, trace):
             counts[it] = counts.get(it, 0) + 1
     if len(accepted) != steps:
         raise RuntimeError(f"{trace}: {len(accepted)} traced steps, expected {steps}")
-    traced = sum(k * v for k, v in counts.items()) / steps
+    traced = sum(k * v for k, v in counts.items()) / steps  # exact; the report rounds to three decimals
     if abs(traced - float(m.group(1))) > 1.5e-3:  # the report prints three decimals
         raise RuntimeError(f"{trace}: {traced:.4f} iterations per step in the trace, {m.group(1)} in the step report")
     accepted.sort()
     return {
         "case": case_name, "integrator": integrator, "setting": " ".join(sets) or "default", "steps": steps,
-        "iterations": float(m.group(1)), "factorizations": float(m.group(2)), "residuals": float(m.group(3)),
+        "iterations": traced, "factorizations": float(m.group(2)), "residuals": float(m.group(3)),
         "rho_median": quantile(accepted, 0.5), "rho_p90": quantile(accepted, 0.9), "cpu_s": float(cpu.group(1)),
         "steps_by_iterations": " ".join(f"{k}:{counts[k]}" for k in sorted(counts)), "wall_s": time.time() - t0,
     }
@@ -115,6 +116,19 @@ def interpolate(points, rho):
     return None
 
 
+SAME_RULE = "certify=energy"  # em-exact stopped by em-galpha's modified-Newton rule (theory §5.10)
+
+
+def exact_runs(rows, case):
+    """(em-exact's run with the case's settings, its run with em-galpha's stopping rule) of a case. The second is
+    the run whose setting names certify=energy; either is None if absent (an older CSV has no same-rule run). If
+    --exact-set itself asked for certify=energy, that one run is both."""
+    ex = [r for r in rows if r["case"] == case and r["integrator"] == "em-exact"]
+    same = next((r for r in ex if SAME_RULE in r["setting"].split()), None)
+    own = next((r for r in ex if r is not same), same)
+    return own, same
+
+
 def tables(rows, cases):
     lines = ["| case | integrator | setting | steps | it/step | factorizations/step | accepted residual median / p90 "
              "| steps by iterations | CPU s |", "|---|---|---|---|---|---|---|---|---|"]
@@ -123,11 +137,12 @@ def tables(rows, cases):
                      f"{r['factorizations']:.3f} | {r['rho_median']:.2e} / {r['rho_p90']:.2e} | "
                      f"{r['steps_by_iterations']} | {r['cpu_s']:.1f} |")
     lines += ["", "| case | em-exact it/step | em-galpha default it/step | ratio at the defaults | em-galpha interpolated "
-              "at em-exact's median / p90 residual | ratio at equal accuracy (median / p90) |",
-              "|---|---|---|---|---|---|"]
+              "at em-exact's median / p90 residual | ratio at equal accuracy (median / p90) "
+              "| em-exact with em-galpha's stopping rule (certify = energy): it/step, ratio |",
+              "|---|---|---|---|---|---|---|"]
     summary = []
     for case in cases:
-        ex = next((r for r in rows if r["case"] == case and r["integrator"] == "em-exact"), None)
+        ex, same = exact_runs(rows, case)
         gd = next((r for r in rows if r["case"] == case and r["integrator"] == "em-galpha" and r["setting"] == "default"), None)
         if ex is None or gd is None:
             fail(f"{case}: the runs lack em-exact's or em-galpha's default run; rerun without --reuse", 1)
@@ -136,9 +151,12 @@ def tables(rows, cases):
         gm, gp = interpolate(pts_med, ex["rho_median"]), interpolate(pts_p90, ex["rho_p90"])
         fmt = lambda v: "outside em-galpha's range" if v is None else f"{v:.3f}"
         rat = lambda v: "–" if v is None else f"{ex['iterations'] / v:.2f}"
+        same_ratio = same and same["iterations"] / gd["iterations"]
+        same_text = "– (no such run)" if same is None else f"{same['iterations']:.4f}, {same_ratio:.5f}"
         lines.append(f"| {case} | {ex['iterations']:.3f} | {gd['iterations']:.3f} | {ex['iterations'] / gd['iterations']:.2f} "
-                     f"| {fmt(gm)} / {fmt(gp)} | {rat(gm)} / {rat(gp)} |")
-        summary.append((case, ex["iterations"] / gd["iterations"], gm and ex["iterations"] / gm, gp and ex["iterations"] / gp))
+                     f"| {fmt(gm)} / {fmt(gp)} | {rat(gm)} / {rat(gp)} | {same_text} |")
+        summary.append((case, ex["iterations"] / gd["iterations"], gm and ex["iterations"] / gm, gp and ex["iterations"] / gp,
+                        same_ratio))
     return "\n".join(lines) + "\n", summary
 
 
@@ -153,12 +171,15 @@ def plot(rows, cases, path):
     fig, axes = plt.subplots(1, len(cases), figsize=(4.6 * len(cases), 4.0), squeeze=False)
     for ax, case in zip(axes[0], cases):
         g = [r for r in rows if r["case"] == case and r["integrator"] == "em-galpha"]  # in sweep order
-        e = [r for r in rows if r["case"] == case and r["integrator"] == "em-exact"]
+        own, same = exact_runs(rows, case)
         for key, style, lab in (("rho_median", "-o", "median"), ("rho_p90", "--s", "90th percentile")):
             ax.semilogx([r[key] for r in g], [r["iterations"] for r in g], style, color="tab:blue", ms=4,
                         label=f"em-galpha (e_floor sweep), {lab}")
-            ax.semilogx([r[key] for r in e], [r["iterations"] for r in e], style[-1], color="tab:red", ms=8,
-                        label=f"em-exact, {lab}")
+            if own is not None:
+                ax.semilogx([own[key]], [own["iterations"]], style[-1], color="tab:red", ms=8, label=f"em-exact, {lab}")
+            if same is not None and same is not own:
+                ax.semilogx([same[key]], [same["iterations"]], style[-1], color="tab:green", ms=8,
+                            label=f"em-exact, em-galpha's rule, {lab}")
         for r in g:
             ax.annotate(r["setting"].replace("e_floor=", ""), (r["rho_median"], r["iterations"]), fontsize=7,
                         xytext=(3, -9), textcoords="offset points")
@@ -167,9 +188,9 @@ def plot(rows, cases, path):
         ax.set_ylabel("Newton iterations per step")
         ax.grid(True, which="both", alpha=0.3)
     handles, labels = axes[0][0].get_legend_handles_labels()
-    fig.legend(handles, labels, loc="lower center", ncol=4, fontsize=8)
+    fig.legend(handles, labels, loc="lower center", ncol=3, fontsize=8)
     fig.suptitle("Newton iterations per step against the accepted residual (modified Newton; em-galpha labelled by e_floor)")
-    fig.tight_layout(rect=(0, 0.07, 1, 1))
+    fig.tight_layout(rect=(0, 0.12, 1, 1))
     fig.savefig(path, dpi=120)
     return True
 
@@ -197,6 +218,9 @@ def measure(a):
     for case in a.cases:
         steps = a.steps or full_steps(bench, os.path.join(ROOT, "apps", "cases", case + ".yaml"))
         jobs.append((case, steps, "em-exact", list(a.exact_set)))
+        same = [kv for kv in a.exact_set if not kv.startswith("certify=")] + [SAME_RULE]
+        if sorted(same) != sorted(a.exact_set):
+            jobs.append((case, steps, "em-exact", same))
         jobs.append((case, steps, "em-galpha", []))
         jobs += [(case, steps, "em-galpha", [f"e_floor={f:g}"]) for f in floors]
     print(f"newton_accuracy.py: {len(jobs)} runs, {a.jobs} at a time, traces in {traces}", flush=True)
@@ -268,10 +292,12 @@ def main():
                 "residual of the accepted iterate (docs/theory/exact-energy-momentum.md §5.9).\n\n" + text)
     figure = plot(rows, cases, os.path.join(a.out, "newton-accuracy.png"))
     print("\n" + text)
-    for case, d, m, p in summary:
+    for case, d, m, p, same in summary:
         f = lambda v: "outside em-galpha's range" if v is None else f"{v:.2f}"
         eq = f"{f(m)} (median) / {f(p)} (p90)"
-        print(f"{case}: em-exact / em-galpha iterations {d:.2f} at the defaults, {eq} at equal accuracy")
+        rule = "no same-rule run" if same is None else f"{same:.5f}"
+        print(f"{case}: em-exact / em-galpha iterations {d:.2f} at the defaults, {eq} at equal accuracy, "
+              f"{rule} with em-galpha's stopping rule (certify = energy)")
     print(f"\nwritten: {os.path.join(a.out, 'newton-accuracy.md')}, newton-accuracy.csv"
           + (", newton-accuracy.png" if figure else ""))
 

@@ -31,4 +31,13 @@ check(v is not None and abs(v - 3.5) < 1e-12, f"log-linear interpolation gives {
 v = na.interpolate(sweep, 3e-9)
 check(v is not None and abs(v - 3.2) < 1e-12, f"at a swept point the interpolation returns its value, got {v}")
 check(na.interpolate(sweep, 1e-7) is None and na.interpolate(sweep, 1e-11) is None, "outside the sweep: None")
-print("check_newton_accuracy: 8 checks passed")
+
+# em-exact's two runs of a case: its own settings, and em-galpha's stopping rule (certify=energy).
+rows = [{"case": "c", "integrator": "em-exact", "setting": "default"},
+        {"case": "c", "integrator": "em-exact", "setting": "predictor=newmark certify=energy"},
+        {"case": "c", "integrator": "em-galpha", "setting": "certify=energy"}]
+own, same = na.exact_runs(rows, "c")
+check(own is rows[0] and same is rows[1], f"exact_runs picks {own}, {same}")
+own, same = na.exact_runs(rows[:1], "c")
+check(own is rows[0] and same is None, "without a same-rule run (an older CSV) the second is None")
+print("check_newton_accuracy: 10 checks passed")
