@@ -210,11 +210,12 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
     }
     kept_.restore(c, *newton_, nopt_.modified, sys, "em-exact");
     // certify = auto with modified Newton: a resumed run keeps the rule it started with (theory §5.8). A
-    // checkpoint without the record was written when auto meant floor (before the fifteenth session). Both
-    // rules skip the accepted iterate's residual, so the solver initialize() built serves either.
+    // checkpoint without the record was written when auto meant floor (before the fifteenth session). A run begun
+    // with certify = energy (theory §5.10) continues with it too. These rules all skip the accepted iterate's
+    // residual, so the solver initialize() built serves each.
     if (certify_ == "auto" && certify_floor_) {
       const double rule = c.scalars.count("certify_rule") ? c.scalar("certify_rule") : 1.0;
-      if (rule == 1.0 || rule == 2.0) use_certify(rule == 2.0 ? "predicted" : "floor");
+      if (rule == 1.0 || rule == 2.0 || rule == 3.0) use_certify(rule == 3.0 ? "energy" : rule == 2.0 ? "predicted" : "floor");
     }
   }
 
@@ -633,7 +634,7 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
   int max_cuts_ = 0;
   double hysteresis_ = 1.0;
   bool correction_ = true;
-  std::string certify_;          // the setting: auto, residual, floor or predicted (resolved by initialize())
+  std::string certify_;          // the setting: auto, residual, floor, predicted or energy (auto resolved by initialize())
   bool certify_floor_ = false;  // certify = floor or predicted (theory §5.3)
   bool predicted_ = false;      // certify = predicted (theory §5.4)
   bool energy_rule_ = false;    // certify = energy (theory §5.10)

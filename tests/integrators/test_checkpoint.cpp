@@ -355,6 +355,10 @@ TEST(CheckpointEmExact, CertifyAutoKeepsTheRuleTheRunStartedWith) {
   EXPECT_EQ(certify_after_restore(floor, true), "floor");
   EXPECT_EQ(certify_after_restore(automatic, false), "predicted");
   EXPECT_EQ(certify_after_restore(automatic, true), "floor");  // an old checkpoint: auto meant floor
+  // A run begun with certify = energy (theory §5.10) and resumed without the setting continues bitwise with it.
+  const Settings energy = {{"newton", "modified"}, {"certify", "energy"}};
+  expect_bitwise_continuation("em-exact", energy, 12, 0.01, true, &automatic);
+  EXPECT_EQ(certify_after_restore(energy, false), "energy");
 }
 
 // The renewal refresh (refresh_cost, theory §5.5) counts steps and iterations since the last refresh of K̄: the
