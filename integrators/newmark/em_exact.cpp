@@ -468,12 +468,13 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
     double energy_first = 0.0;  // E_1
     auto hook = [&](int k, const double*, const double* du, const double* f) -> bool {
       const double rk = history.back();
-      const double step = (Eigen::Map<const Eigen::VectorXd>(du, n).cwiseAbs().array() * uscale_.array()).maxCoeff();
+      const Eigen::Map<const Eigen::VectorXd> d(du, n);
+      const double step = (d.cwiseAbs().array() * uscale_.array()).maxCoeff();
       if (k == 1) first_step = step;
       const double step_before = prev_step;
       prev_step = step;
       if (energy_rule_) {
-        const double Ek = std::abs(Eigen::Map<const Eigen::VectorXd>(du, n).dot(Eigen::Map<const Eigen::VectorXd>(f, n)));
+        const double Ek = std::abs(d.dot(Eigen::Map<const Eigen::VectorXd>(f, n)));
         if (k == 1) energy_first = Ek;
         if ((k > 1 && Ek <= cc_tol_ * energy_first) || energy_floor.accept(Ek) || step <= step_tol_) {
           accept_last_evaluated = false;  // u_k, unevaluated (as em-galpha accepts it)
