@@ -128,6 +128,19 @@ std::string find_script(const std::string& file_name) {
   return {};
 }
 
+std::vector<std::pair<std::string, std::string>> shipped_study_files() {
+  std::vector<std::pair<std::string, std::string>> out;
+  for (const auto& d : search_dirs("apps/studies", "share/shelldyn/studies")) {
+    std::error_code ec;
+    for (const auto& e : fs::directory_iterator(d, ec))
+      if (e.path().extension() == ".yaml" && fs::is_regular_file(e.path(), ec))
+        out.emplace_back(e.path().stem().string(), e.path().string());
+    if (!out.empty()) break;
+  }
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
 bool run_python_script(const std::string& script, const std::vector<std::string>& args, std::ostream& warn) {
   if (script.empty()) {
     warn << "warning: plot script not found (scripts/ of the source tree or share/shelldyn/scripts); no plots written"

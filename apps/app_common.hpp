@@ -41,6 +41,11 @@ std::string find_case_file(const std::string& file_name);
 // A script of scripts/ (e.g. "plot_run.py"), searched like find_case_file; empty if not found.
 std::string find_script(const std::string& file_name);
 
+// The shipped study files (apps/studies/*.yaml, installed to <prefix>/share/shelldyn/studies;
+// docs/reference/study-files.md), searched like find_case_file: name (file stem, e.g. "flying-plate") ->
+// path, sorted by name; the first folder that holds any wins.
+std::vector<std::pair<std::string, std::string>> shipped_study_files();
+
 // Runs `python3 SCRIPT ARGS...` (python: $SHELLDYN_PYTHON, else /usr/bin/python3, else python3 on
 // PATH). Never throws: if the interpreter or the script is missing, or it fails, prints ONE warning
 // line to `warn` and returns false. The scripts themselves print one warning and exit 0 when

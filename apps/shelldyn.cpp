@@ -526,54 +526,87 @@ void add_compare_command(CLI::App& app, Action& action, const std::string& comma
 }
 
 // --- study -------------------------------------------------------------------------------------------
-// `shelldyn study BENCHMARK`: the integrator study of integrators/runs/study.hpp (work–precision sweep on a
-// window + full-duration conservation runs, resumable), then scripts/plot_study.py. Exit 0 when every run
+// `shelldyn study BENCHMARK|FILE`: the integrator study of integrators/runs/study.hpp (work–precision sweep on
+// a window + full-duration conservation runs, resumable) from a study file (docs/reference/study-files.md: a
+// shipped apps/studies/<benchmark>.yaml or the user's own), then scripts/plot_study.py. Exit 0 when every run
 // completed or stopped at the per-run budget, 3 when some failed, 1 for bad input.
 struct StudyCommandOptions {
   std::string benchmark, case_path, out_dir, command, only = "all";
+  std::vector<std::string> add_methods;
   int jobs = 2;
   double max_wall_per_run = 0.0;
   long long max_steps_per_run = 0;
   bool rerun = false, dry_run = false, report_only = false, no_plots = false;
 };
 
+// The study file `study` names: a shipped study by name, else a file.
+std::string study_file_path(const std::string& name) {
+  std::string names;
+  for (const auto& [n, path] : app::shipped_study_files()) {
+    if (n == name) return path;
+    names += (names.empty() ? "" : ", ") + n;
+  }
+  std::error_code ec;
+  if (fs::exists(name, ec)) return name;  // load_study_file refuses what is not a regular file
+  throw std::invalid_argument("study: unknown benchmark or study file '" + name + "' (shipped: " + (names.empty() ? "none found" : names) +
+                              ", all; or the path of a study file)");
+}
+
+// The study's case: --case, else the study file's `case:` relative to the study file, else a shipped case.
+std::string study_case_path(const StudyPreset& p, const std::string& case_option) {
+  if (!case_option.empty()) return case_option;
+  if (!p.case_path.empty()) return p.case_path;
+  // Not next to the study file (e.g. a copy of a shipped study file elsewhere): the shipped case of that name.
+  try {
+    return app::find_case_file(fs::path(p.case_file).filename().string());
+  } catch (const std::invalid_argument& e) {
+    throw std::invalid_argument(p.case_where + ": " + e.what());
+  }
+}
+
 int run_study_command(const StudyCommandOptions& o) {
-  // `all`: the three benchmarks in one batch of runs (run_studies), each into its own folder.
-  std::vector<std::string> benchmarks;
+  // `all`: the shipped studies in one batch of runs (run_studies), each into its own folder.
+  std::vector<std::string> files;
   if (o.benchmark == "all") {
     if (!o.case_path.empty()) throw std::invalid_argument("--case needs one benchmark, not 'all' (each benchmark has its own case)");
-    for (const auto& p : study_presets()) benchmarks.push_back(p.name);
+    for (const auto& [n, path] : app::shipped_study_files()) files.push_back(path);
+    if (files.empty()) throw std::invalid_argument("study all: no shipped study files found (apps/studies or share/shelldyn/studies)");
   } else {
-    benchmarks.push_back(o.benchmark);
+    files.push_back(study_file_path(o.benchmark));
   }
   if (o.jobs < 1) throw std::invalid_argument("--jobs must be >= 1 (got " + std::to_string(o.jobs) + ")");
   if (o.only != "window" && o.only != "full" && o.only != "all")
     throw std::invalid_argument("--only must be window, full or all (got '" + o.only + "')");
   if (!(o.max_wall_per_run >= 0.0) || !std::isfinite(o.max_wall_per_run) || o.max_steps_per_run < 0)
     throw std::invalid_argument("--max-wall-per-run and --max-steps-per-run must be >= 0 (0: no budget)");
-  // Where the runs execute: as `shelldyn compare` (the ranks of mpirun/srun, else --jobs threads).
-  const std::unique_ptr<RunExecutor> executor = app::make_sweep_executor(o.jobs, 0);
   std::vector<StudyOptions> studies;
-  for (const auto& b : benchmarks) {
+  for (const auto& file : files) {
     StudyOptions so;
-    so.preset = study_preset(b);
-    so.case_path = o.case_path.empty() ? app::find_case_file(so.preset.case_file) : o.case_path;
+    so.preset = load_study_file(file);
+    for (const auto& spec : o.add_methods) add_study_method(so.preset, spec, "--add-method '" + spec + "'");
+    if (o.only == "window" && !so.preset.has_window) throw std::invalid_argument("--only window: " + file + " has no window: section");
+    if (o.only == "full" && !so.preset.has_full) throw std::invalid_argument("--only full: " + file + " has no full: section");
+    so.case_path = study_case_path(so.preset, o.case_path);
     if (o.only != "all") so.groups = {o.only};
-    so.out_dir = o.out_dir.empty() ? (fs::path("results") / b / "study").string()
-                 : benchmarks.size() > 1 ? (fs::path(o.out_dir) / b).string()
-                                         : o.out_dir;
+    so.out_dir = o.out_dir.empty() ? (fs::path("results") / so.preset.name / "study").string()
+                 : files.size() > 1 ? (fs::path(o.out_dir) / so.preset.name).string()
+                                    : o.out_dir;
     so.max_wall_per_run = o.max_wall_per_run;
     so.max_steps_per_run = o.max_steps_per_run;
     so.rerun = o.rerun;
     so.dry_run = o.dry_run;
     so.report_only = o.report_only;
+    so.command = o.command;
+    if (!o.dry_run) app::check_output_folder(so.out_dir);
+    studies.push_back(so);
+  }
+  // Where the runs execute: as `shelldyn compare` (the ranks of mpirun/srun, else --jobs threads).
+  const std::unique_ptr<RunExecutor> executor = app::make_sweep_executor(o.jobs, 0);
+  for (auto& so : studies) {
     so.execution.jobs = o.jobs;
     so.execution.executor = executor.get();
     so.report = executor->collects();
     so.log = so.report ? &std::cout : nullptr;
-    so.command = o.command;
-    if (!o.dry_run) app::check_output_folder(so.out_dir);
-    studies.push_back(so);
   }
   const std::vector<StudyResult> results = run_studies(studies);
   if (o.dry_run || !executor->collects()) return 0;
@@ -594,18 +627,22 @@ void add_study_command(CLI::App& app, Action& action, const std::string& command
   auto o = std::make_shared<StudyCommandOptions>();
   o->command = command;
   std::string names;
-  for (const auto& p : study_presets()) names += (names.empty() ? "" : "|") + p.name;
+  for (const auto& [n, path] : app::shipped_study_files()) names += (names.empty() ? "" : "|") + n;
   CLI::App* sub = app.add_subcommand(
-      "study", "Work-precision sweep of every integrator on a benchmark + full-duration conservation runs (resumable); "
-               "write study.csv, study.md and plots");
+      "study", "Work-precision sweep of every method of a study file on its case + full-duration conservation runs "
+               "(resumable); write study.csv, study.md and plots");
   sub->add_option("benchmark", o->benchmark,
-                  "Benchmark: " + names + ", or all (the three in one batch of runs, longest first; with -o DIR each goes "
-                  "to DIR/<benchmark>)")
+                  "A shipped study: " + names + ", or all (the shipped ones in one batch of runs, longest first; with -o DIR "
+                  "each goes to DIR/<name>); or a study file of your own (YAML, docs/reference/study-files.md)")
       ->required();
-  sub->add_option("--case", o->case_path, "Case file to use instead of apps/cases/<benchmark>.yaml (same preset)");
-  sub->add_option("-o,--output", o->out_dir, "Result folder (default: results/<benchmark>/study)");
+  sub->add_option("--case", o->case_path, "Case file to use instead of the study file's case: (same methods and sweeps)");
+  sub->add_option("--add-method", o->add_methods,
+                  "Comma-separated methods NAME[:KEY=VALUE...] (any registered integrator) added to the study: swept over "
+                  "the window's dt or rtol list and, fixed-step, run over the full duration")
+      ->delimiter(',');
+  sub->add_option("-o,--output", o->out_dir, "Result folder (default: results/<name>/study)");
   sub->add_option("--jobs", o->jobs, "Runs at a time, each single-threaded (default 2); the runs of all groups (and with "
-                                     "'all' of all benchmarks) form one batch, longest expected first");
+                                     "'all' of all studies) form one batch, longest expected first");
   sub->add_option("--only", o->only, "Run only the group window (work-precision sweep) or full (full duration); default all");
   sub->add_option("--max-wall-per-run", o->max_wall_per_run,
                   "Budget per run in wall seconds (default 0: none); a run that hits it is reported as stopped at budget "

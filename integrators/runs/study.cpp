@@ -1,5 +1,6 @@
 #include "integrators/runs/study.hpp"
 #include "integrators/runs/number_text.hpp"
+#include "integrators/runs/case_integrator.hpp"
 #include "integrators/runs/registry.hpp"
 
 #include "lib/problem.hpp"
@@ -55,20 +56,28 @@ struct PlannedRun {
 
 std::vector<PlannedRun> plan(const StudyPreset& p, const std::string& group) {
   std::vector<PlannedRun> runs;
-  auto name_of = [](const std::string& spec) { return spec.substr(0, spec.find(':')); };
+  auto in = [](const std::vector<double>& v, double x) { return std::find(v.begin(), v.end(), x) != v.end(); };
   if (group == "window") {
     if (!p.reference_spec.empty()) {
       const CompareRun ref = parse_compare_spec(p.reference_spec);
       runs.push_back({p.reference_spec, "reference", ref.integrator, ref.dt, 0.0});
     }
-    // Expensive runs first, so that the two workers finish together: tight tolerances and small steps.
-    std::vector<double> rtols = p.rtols, dts = p.dts;
-    std::sort(rtols.begin(), rtols.end());
-    std::sort(dts.begin(), dts.end());
+    // Expensive runs first, so that the two workers finish together: tight tolerances and small steps. Each
+    // value of the union of the methods' sweeps, ascending, then the methods in file order that sweep over it
+    // (with one shared sweep: every method at the first value, then at the next, ...).
+    std::vector<double> rtols, dts;
+    for (const auto& m : p.methods)
+      if (m.window) (m.adaptive ? rtols : dts).insert((m.adaptive ? rtols : dts).end(), m.sweep.begin(), m.sweep.end());
+    for (auto* v : {&rtols, &dts}) {
+      std::sort(v->begin(), v->end());
+      v->erase(std::unique(v->begin(), v->end()), v->end());
+    }
     for (double r : rtols)
-      for (const auto& s : p.adaptive_specs) runs.push_back({s + ":rtol=" + num(r), "adaptive", name_of(s), 0.0, r});
+      for (const auto& m : p.methods)
+        if (m.window && m.adaptive && in(m.sweep, r)) runs.push_back({m.spec + ":rtol=" + num(r), "adaptive", m.integrator, 0.0, r});
     for (double dt : dts)
-      for (const auto& s : p.fixed_specs) runs.push_back({s + ":dt=" + num(dt), "fixed", name_of(s), dt, 0.0});
+      for (const auto& m : p.methods)
+        if (m.window && !m.adaptive && in(m.sweep, dt)) runs.push_back({m.spec + ":dt=" + num(dt), "fixed", m.integrator, dt, 0.0});
   } else if (group == "full") {
     for (const auto& s : p.full_baselines) {
       const CompareRun b = parse_compare_spec(s);
@@ -77,8 +86,9 @@ std::vector<PlannedRun> plan(const StudyPreset& p, const std::string& group) {
         if (k == "rtol") rtol = std::stod(v);
       runs.push_back({s, "baseline", b.integrator, 0.0, rtol});
     }
-    for (const auto& s : p.fixed_specs)
-      runs.push_back({p.full_dt > 0.0 ? s + ":dt=" + num(p.full_dt) : s, "fixed", name_of(s), p.full_dt, 0.0});
+    for (const auto& m : p.methods)
+      if (m.full && !m.adaptive)
+        runs.push_back({p.full_dt > 0.0 ? m.spec + ":dt=" + num(p.full_dt) : m.spec, "fixed", m.integrator, p.full_dt, 0.0});
   } else {
     throw std::invalid_argument("study: unknown group '" + group + "' (use window, full)");
   }
@@ -86,77 +96,6 @@ std::vector<PlannedRun> plan(const StudyPreset& p, const std::string& group) {
 }
 
 }  // namespace
-
-std::vector<StudyPreset> study_presets() {
-  const auto names = integrator_names();
-  const bool have_exact = std::find(names.begin(), names.end(), "em-exact") != names.end();
-  std::vector<std::string> fixed = {"em-galpha", "galpha:rho_inf=1", "galpha:rho_inf=0.8", "midpoint", "newmark"};
-  if (have_exact) fixed.insert(fixed.begin() + 1, "em-exact");
-  const std::vector<std::string> adaptive = {"ida-bdf", "arkode-dirk", "arkode-erk"};
-  std::vector<StudyPreset> out;
-  {
-    StudyPreset p;
-    p.name = "flying-plate";
-    p.case_file = "flying-plate.yaml";
-    p.window_t_end = 0.5;  // inside the load (0-5 s): the explicit baseline's stability limit sets the budget
-    p.window_output = 0.005;
-    p.fixed_specs = fixed;
-    p.dts = {4e-3, 2e-3, 1e-3, 5e-4};
-    p.adaptive_specs = adaptive;
-    p.rtols = {1e-3, 1e-4, 1e-5, 1e-6};
-    p.reference_spec = "em-galpha:dt=0.000125";
-    p.full_baselines = {"ida-bdf:rtol=0.0001:atol=1e-06"};
-    p.note = "window: the first 0.5 s of the load (hat, 0-5 s); full: the paper's 20 s at its dt = 1e-3";
-    out.push_back(p);
-  }
-  {
-    StudyPreset p;
-    p.name = "cylindrical-panel";
-    p.case_file = "cylindrical-panel.yaml";
-    p.window_t_end = 0.004;  // inside the load (0-0.02 s)
-    p.window_output = 4e-5;
-    p.fixed_specs = fixed;
-    p.dts = {4e-5, 2e-5, 1e-5, 5e-6};
-    p.adaptive_specs = adaptive;
-    p.rtols = {1e-3, 1e-4, 1e-5, 1e-6};
-    p.reference_spec = "em-galpha:dt=1.25e-06";
-    p.full_baselines = {"ida-bdf:rtol=0.0001:atol=1e-06"};
-    p.note = "window: the first 0.004 s of the load (hat, 0-0.02 s); full: 0.1 s at the case's dt = 1e-5";
-    out.push_back(p);
-  }
-  {
-    StudyPreset p;
-    p.name = "pinched-hemisphere";
-    p.case_file = "pinched-hemisphere.yaml";
-    // Inside the pinch (0-0.03 s). 0.0025 s rather than a longer window: on this 5 440-unknown mesh the SUNDIALS
-    // baselines cost 0.3-2 CPU s per step (ida-bdf: Newton-matrix factorizations of 10 882 unknowns while its
-    // step grows; arkode-erk: its stability-limited step of ~8.5e-5 s with 8 mass solves per step), so 0.005 s
-    // took 35-170 CPU s per run (docs/results.md §7.4).
-    p.window_t_end = 0.0025;
-    p.window_output = 1.25e-4;
-    p.fixed_specs = fixed;
-    p.dts = {5e-4, 2.5e-4, 1.25e-4, 6.25e-5};
-    p.adaptive_specs = adaptive;
-    p.rtols = {1e-3, 1e-4, 1e-5, 1e-6};
-    p.reference_spec = "em-galpha:dt=1.5625e-05";
-    p.full_dt = 1.25e-3;
-    p.full_output = 1.25e-3;
-    p.full_baselines = {"ida-bdf:rtol=0.0001:atol=1e-06"};
-    p.note = "window: the first 0.0025 s of the pinch (0-0.03 s; short because the baselines cost 0.3-2 CPU s per step "
-             "here); full: 1.25 s at 10x the paper's dt (1.25e-3) to fit the time budget (the paper-dt run is in docs/results.md)";
-    out.push_back(p);
-  }
-  return out;
-}
-
-StudyPreset study_preset(const std::string& name) {
-  std::string list;
-  for (const auto& p : study_presets()) {
-    if (p.name == name) return p;
-    list += (list.empty() ? "" : ", ") + p.name;
-  }
-  throw std::invalid_argument("study: unknown benchmark '" + name + "' (available: " + list + ")");
-}
 
 std::pair<std::string, double> stopped_budget(const std::string& status) {
   for (const std::string kind : {"max-wall", "max-steps"}) {
@@ -200,13 +139,30 @@ struct StudyPlan {
   StudyResult result;
   std::map<std::string, std::vector<std::pair<PlannedRun, std::string>>> labelled;  // group -> (run, label)
   std::vector<CompareOptions> batch;  // the groups' pending runs
+  std::vector<std::string> groups;    // the requested groups the study has (window without a window: section is none)
   explicit StudyPlan(Problem p) : first(std::move(p)) {}
 };
 
 std::unique_ptr<StudyPlan> plan_study(const StudyOptions& o) {
   if (o.out_dir.empty()) throw std::invalid_argument("study: an output folder is required");
   const StudyPreset& p = o.preset;
+  {
+    // The case as `shelldyn run` would take it (case_integrator.hpp): its own integrator block too, although the
+    // study's runs replace the integrator, so that a case `run` refuses (a setting the integrator does not know,
+    // the static solver) is not silently accepted here.
+    const CaseSpec spec = load_case(o.case_path);
+    try {
+      make_case_integrator(spec, "", {}, spec.time.dt);
+    } catch (const std::invalid_argument& e) {
+      const std::string msg = e.what();  // "FILE:LINE: integrator.KEY: ..." where the case's block is the cause
+      if (msg.rfind(o.case_path, 0) == 0) throw;
+      throw std::invalid_argument(o.case_path + ": " + msg);
+    }
+  }
   auto sp = std::make_unique<StudyPlan>(load_problem(o.case_path));  // validates the case once, up front
+  for (const auto& group : o.groups)
+    if ((group == "window" && p.has_window) || (group == "full" && p.has_full)) sp->groups.push_back(group);
+    else if (group != "window" && group != "full") throw std::invalid_argument("study: unknown group '" + group + "' (use window, full)");
   sp->loads_end = sp->first.model->loads_end();
   for (const auto& m : sp->first.disc.monitors) sp->monitors.push_back(m.name);
   StudyResult& result = sp->result;
@@ -215,7 +171,7 @@ std::unique_ptr<StudyPlan> plan_study(const StudyOptions& o) {
     if (o.log) *o.log << line << std::endl;
   };
 
-  for (const auto& group : o.groups) {
+  for (const auto& group : sp->groups) {
     const std::vector<PlannedRun> runs = plan(p, group);
     CompareOptions co = o.execution;
     co.case_path = o.case_path;
@@ -223,7 +179,7 @@ std::unique_ptr<StudyPlan> plan_study(const StudyOptions& o) {
     co.rtols.clear();
     co.reference.clear();
     co.vtu_every = 0;
-    co.t_end = group == "window" ? p.window_t_end : -1.0;
+    co.t_end = group == "window" ? p.window_t_end : p.full_t_end;
     co.output_interval = group == "window" ? p.window_output : p.full_output;
     co.out_dir = (fs::path(o.out_dir) / group).string();
     co.max_wall = o.max_wall_per_run;
@@ -286,7 +242,7 @@ StudyResult report_study(const StudyOptions& o, StudyPlan& plan) {
         } catch (const std::exception&) {
         }
       }
-  for (const auto& group : o.groups) {
+  for (const auto& group : plan.groups) {
     for (const auto& [run, label] : labelled[group]) {
       StudyRow row;
       row.group = group;
@@ -396,7 +352,8 @@ StudyResult report_study(const StudyOptions& o, StudyPlan& plan) {
     md << "# Integrator study: " << p.name << "\n\n";
     md << "- case: `" << o.case_path << "` (" << first.spec.description << ")\n";
     md << "- command: `" << o.command << "`\n";
-    md << "- " << p.note << "\n";
+    if (!p.source.empty()) md << "- study file: `" << p.source << "`\n";
+    if (!p.note.empty()) md << "- " << p.note << "\n";
     md << "- loads end at " << num(loads_end) << " s. Energy error (energy balance): max_t |H(t) − H(0)| / max_t (K + V)(t) "
           "with H = K + V − W_ext, which the exact flow keeps constant with or without loads; after the loads: max |H − "
           "H_ref|/(K + V)_ref from the loads' end on (n/a when the run ends before). Displacement error: max over the output times of ‖(";
@@ -412,7 +369,7 @@ StudyResult report_study(const StudyOptions& o, StudyPlan& plan) {
          << ". A run that hits it is listed as \"stopped at budget\" with the time it reached and what it cost; "
             "it is not complete and is no point of the work–precision diagram.\n";
     md << "\n";
-    for (const auto& group : o.groups) {
+    for (const auto& group : plan.groups) {
       md << "## " << (group == "window" ? "Work–precision window, t ≤ " + num(p.window_t_end) + " s" : std::string("Full duration"))
          << "\n\n";
       md << "| run | Δt or rtol | steps | RHS evals | factorizations | CPU [s] | energy error | after loads | displ. error | "
@@ -434,11 +391,12 @@ StudyResult report_study(const StudyOptions& o, StudyPlan& plan) {
       }
       md << "\n";
     }
-    // Headline: the cheapest energy-momentum window run against the cheapest baseline run as accurate in energy.
+    // Headline: the cheapest window run of the headline methods (the study file's `headline:`, default the
+    // energy-momentum schemes em-galpha and em-exact) against the cheapest baseline run as accurate in energy.
     const StudyRow* em = nullptr;
     for (const auto& r : result.rows)
       if (r.group == "window" && r.kind == "fixed" && r.status == "complete" &&
-          (r.integrator == "em-galpha" || r.integrator == "em-exact") && (!em || r.cpu_s < em->cpu_s))
+          std::find(p.headline.begin(), p.headline.end(), r.integrator) != p.headline.end() && (!em || r.cpu_s < em->cpu_s))
         em = &r;
     if (em) {
       const StudyRow* match = nullptr;

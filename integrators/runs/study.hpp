@@ -1,16 +1,19 @@
-// The integrator study behind `shelldyn study BENCHMARK` (docs/results.md, "Integrator study"): for one of the
-// paper's benchmarks, a work–precision sweep of every time integrator on a window every method can afford,
-// plus full-duration conservation runs. Built on the comparison machinery of compare.hpp: the groups' runs are
+// The integrator study behind `shelldyn study BENCHMARK|FILE` (docs/results.md, "Integrator study"): for one
+// case, a work–precision sweep of every method of a study file (docs/reference/study-files.md; the paper's
+// three benchmarks are the shipped apps/studies/*.yaml) on a window every method can afford, plus
+// full-duration conservation runs. Built on the comparison machinery of compare.hpp: the groups' runs are
 // one run_comparisons() batch (same specs, labels, settings inheritance and run execution as `shelldyn
 // compare`, so the study runs wherever and however compare runs). Runs start longest expected first across
 // both groups, so the full group's long baseline run overlaps the window's runs instead of ending the study alone.
 //
 // Groups (sub-folders of the study folder):
 //   window/   the work–precision sweep on [0, window_t_end] (short enough for the explicit baseline, whose
-//             stability limit does not depend on its tolerance): the fixed-step schemes over the Δt list, the adaptive SUNDIALS
-//             baselines over the rtol list, and one tight reference run (`reference`, a fixed-step scheme at
-//             a Δt well below the sweep's) for displacement errors;
-//   full/     the case's full duration: every fixed-step scheme at full_dt and the cheapest baseline.
+//             stability limit does not depend on its tolerance): the fixed-step methods over their Δt lists,
+//             the adaptive methods over their rtol lists, and one tight reference run (`reference`, a
+//             fixed-step scheme at a Δt well below the sweep's) for displacement errors;
+//   full/     the case's full duration: every fixed-step method at full_dt and the full.runs (baselines).
+// The case's own integrator block is checked as `shelldyn run` checks it (make_case_integrator), although the
+// study's runs replace the integrator: a case that `run` refuses is refused here too.
 // Resumable: a run whose <group>/<label>/run.json says "status": "complete" is not run again (delete its
 // folder, or pass rerun, to repeat it); only the missing runs go to run_comparisons().
 // Per-run budget (max_wall_per_run / max_steps_per_run, the run driver's --max-wall / --max-steps): a run
@@ -41,28 +44,54 @@
 
 namespace shelldyn {
 
-// One benchmark's study: which runs, on which window. Chosen so that the three benchmarks together fit in
-// 30 minutes on 2 cores (docs/results.md lists the measured times).
-struct StudyPreset {
-  std::string name;                       // flying-plate | cylindrical-panel | pinched-hemisphere
-  std::string case_file;                  // file name under apps/cases
-  double window_t_end = 0.0;              // work–precision window [0, window_t_end]
-  double window_output = 0.0;             // output interval on the window
-  std::vector<std::string> fixed_specs;   // fixed-step schemes (compare specs without dt)
-  std::vector<double> dts;                // their Δt sweep
-  std::vector<std::string> adaptive_specs;  // SUNDIALS baselines (compare specs without rtol)
-  std::vector<double> rtols;              // their rtol sweep
-  std::string reference_spec;             // tight reference on the window (a compare spec with dt)
-  double full_dt = 0.0;                   // Δt of the full-duration runs (0: the case's)
-  double full_output = 0.0;               // output interval of the full-duration runs (0: the case's)
-  std::vector<std::string> full_baselines;  // baseline specs run over the full duration
-  std::string note;                       // printed in study.md (why this window / Δt)
+// A method of a study (one entry of the study file's `methods:` list, docs/reference/study-files.md): an
+// integrator with its settings, swept on the window over Δt (fixed-step) or rtol (adaptive = the integrator
+// has an `rtol` setting, probed through the registry by name, so a registered plug-in method works the same).
+struct StudyMethod {
+  std::string spec;                       // compare spec NAME[:KEY=VALUE...] without dt / rtol
+  std::string integrator;                 // NAME
+  bool adaptive = false;                  // swept over rtol (else over dt)
+  std::vector<double> sweep;              // its Δt (fixed-step) or rtol (adaptive) values on the window
+  bool window = true;                     // in the window's work–precision sweep
+  bool full = true;                       // fixed-step only: also a full-duration run (at full_dt)
+  std::string where;                      // "FILE:LINE" of its entry, for messages
 };
 
-// The presets of the three benchmarks; fixed_specs includes em-exact when that integrator is registered.
-std::vector<StudyPreset> study_presets();
-// The preset called `name`; throws std::invalid_argument listing the names otherwise.
-StudyPreset study_preset(const std::string& name);
+// One study: which runs, on which window (a study file, load_study_file; the shipped ones are
+// apps/studies/<benchmark>.yaml, chosen so that the three benchmarks together fit in 30 minutes on 2 cores,
+// docs/results.md lists the measured times).
+struct StudyPreset {
+  std::string name;                       // study name: folder default results/<name>/study, log prefixes
+  std::string source;                     // the study file ("" for a preset built in code)
+  std::string case_file;                  // as written in the study file (`case:`)
+  std::string case_path;                  // case_file resolved against the study file's folder ("" if no such file)
+  std::string case_where;                 // "FILE:LINE" of `case:`
+  std::string note;                       // printed in study.md (why this window / Δt)
+  bool has_window = true;                 // the window group exists
+  double window_t_end = 0.0;              // work–precision window [0, window_t_end]
+  double window_output = 0.0;             // output interval on the window (0: the case's)
+  std::vector<double> dts, rtols;         // the window's default sweeps (methods without their own dt / rtol list)
+  std::string reference_spec;             // tight reference on the window (a compare spec with dt; "" none)
+  bool has_full = true;                   // the full group exists
+  double full_t_end = -1.0;               // end of the full-duration runs (< 0: the case's)
+  double full_dt = 0.0;                   // Δt of the full-duration runs (0: the case's)
+  double full_output = 0.0;               // output interval of the full-duration runs (0: the case's)
+  std::vector<std::string> full_baselines;  // complete specs run over the full duration (kind "baseline")
+  std::vector<StudyMethod> methods;       // in file order
+  std::vector<std::string> headline = {"em-galpha", "em-exact"};  // integrators of the study.md headline
+};
+
+// Reads and validates a study file (YAML, schema in docs/reference/study-files.md). Every method is made
+// once through the registry (make_integrator, by name), so unknown integrators, unknown settings and bad
+// values fail here, before any run. Errors: std::invalid_argument "FILE:LINE: key.path: reason (how to fix)".
+// A method with `optional: true` whose integrator is not registered in this build is left out.
+StudyPreset load_study_file(const std::string& path);
+StudyPreset load_study_from_string(const std::string& text, const std::string& source, const std::string& base_dir);
+
+// Adds a method given as a spec NAME[:KEY=VALUE...] (e.g. `shelldyn study --add-method`) to the study: swept
+// over the window's default Δt or rtol list, and (fixed-step) run over the full duration. `where` prefixes
+// error messages (e.g. "--add-method 'x'").
+void add_study_method(StudyPreset& preset, const std::string& spec, const std::string& where);
 
 struct StudyOptions {
   StudyPreset preset;
