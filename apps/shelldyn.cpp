@@ -23,6 +23,7 @@
 #include "integrators/runs/case_integrator.hpp"
 #include "integrators/runs/compare.hpp"
 #include "integrators/runs/study.hpp"
+#include "integrators/runs/plugin.hpp"
 #include "integrators/runs/registry.hpp"
 #include "integrators/integrator.hpp"
 #include "integrators/runs/run_driver.hpp"
@@ -69,6 +70,22 @@ std::string vec_text(const Vec3& v) {
   return os.str();
 }
 
+// A case file path, or the name of a shipped case (apps/cases/NAME.yaml, e.g. flying-plate), as `compare` takes.
+std::string resolve_case_path(const std::string& given) {
+  std::error_code ec;
+  if (fs::exists(given, ec) || given.find('/') != std::string::npos) return given;
+  return app::find_case_file(given + (fs::path(given).extension() == ".yaml" ? "" : ".yaml"));
+}
+
+// --plugin PATH (repeatable) of run, check, compare, study and resume. The plugins are loaded by main() before
+// the command line is parsed (so that --help lists their integrators); the option is declared for the parser.
+void add_plugin_option(CLI::App* sub, std::vector<std::string>& paths) {
+  sub->add_option("--plugin", paths,
+                  "Load integrators from a plugin shared library (repeatable; also the case-file key plugins: and the "
+                  "environment variable SHELLDYN_PLUGINS, colon-separated); see docs/tutorials/05-your-own-integrator.md")
+      ->allow_extra_args(false);  // one path per --plugin (a following case name is not a plugin)
+}
+
 // --- check -------------------------------------------------------------------------------------------
 struct CheckOptions {
   std::string case_path;
@@ -76,6 +93,7 @@ struct CheckOptions {
   std::string command;  // the full command line, recorded in run.json
   bool overwrite = false;
   std::string state_file;  // static: start from this checkpoint (or run folder holding one) or run VTU
+  std::vector<std::string> plugins;  // loaded by main()
 };
 
 void print_summary(std::ostream& out, const CaseSpec& c, const Discretization& d) {
@@ -177,7 +195,7 @@ VtuFields initial_fields(const Discretization& d) {
 }
 
 int run_check(const CheckOptions& o) {
-  const CaseSpec spec = load_case(o.case_path);
+  const CaseSpec spec = load_case(resolve_case_path(o.case_path));
   validate_case_integrator(spec);  // exactly as `run` will (FILE:LINE: integrator.KEY: ...)
   const Discretization d = build_discretization(spec);
   VtuFields fields = initial_fields(d);
@@ -225,9 +243,10 @@ void add_check_command(CLI::App& app, Action& action, const std::string& command
   opts->command = command;
   CLI::App* sub = app.add_subcommand(
       "check", "Validate a case file, print a summary and write the initial state (VTU, PVD, run.json)");
-  sub->add_option("case", opts->case_path, "Case file (YAML), e.g. apps/cases/flying-plate.yaml")->required();
+  sub->add_option("case", opts->case_path, "Case file (YAML), or a case name of apps/cases such as flying-plate")->required();
   sub->add_option("-o,--output", opts->out_dir, "Result folder (default: results/<case name>)");
   sub->add_flag("--overwrite", opts->overwrite, "Replace the results of an earlier command in the result folder");
+  add_plugin_option(sub, opts->plugins);
   sub->callback([opts, &action] { action = [opts] { return run_check(*opts); }; });
 }
 
@@ -235,6 +254,7 @@ void add_check_command(CLI::App& app, Action& action, const std::string& command
 struct RunCommandOptions {
   std::string case_path, out_dir, integrator, command, checkpoint_every;
   std::vector<std::string> settings;  // key=value
+  std::vector<std::string> plugins;   // loaded by main()
   double dt = 0.0, t_end = -1.0, output_every = 0.0, max_wall = 0.0;
   int vtu_every = -1, threads = 0;
   long long max_steps = 0;
@@ -272,7 +292,7 @@ int run_run(const RunCommandOptions& o) {
   RunOptions ro;
   ro.integrator = o.integrator;
   for (const auto& kv : o.settings) ro.settings.push_back(split_setting(kv));
-  CaseSpec spec = load_case(o.case_path);
+  CaseSpec spec = load_case(resolve_case_path(o.case_path));
   make_case_integrator(spec, o.integrator, ro.settings, o.dt > 0.0 ? o.dt : spec.time.dt);  // before any output
   const std::string integrator_name = o.integrator.empty() ? spec.integrator.name : o.integrator;
   ro.out_dir = o.out_dir.empty() ? (fs::path("results") / spec.name / integrator_name).string() : o.out_dir;
@@ -295,8 +315,11 @@ int run_run(const RunCommandOptions& o) {
   std::cout << "shelldyn run: " << problem.spec.name << " with " << integrator_name << " -> " << ro.out_dir << std::endl;
   const RunSummary s = run_dynamic(problem, ro);
   if (o.quiet) {  // one line: status, steps, energy error after the loads
-    std::printf("%s: %s, %ld steps, max |H - H_ref|/(K+V)_ref after loads %.3g -> %s\n", integrator_name.c_str(),
-                s.status.c_str(), s.totals.steps, s.max_rel_drift, ro.out_dir.c_str());
+    char drift[96];
+    if (s.after_loads) std::snprintf(drift, sizeof drift, "%.3g", s.max_rel_drift);
+    else std::snprintf(drift, sizeof drift, "n/a (loads still on until t = %.6g)", s.loads_end);
+    std::printf("%s: %s, %ld steps, max |H - H_ref|/(K+V)_ref after loads %s -> %s\n", integrator_name.c_str(),
+                s.status.c_str(), s.totals.steps, drift, ro.out_dir.c_str());
   } else {
     print_run_summary(std::cout, s);
     std::cout << "wrote " << ro.out_dir << "/history.csv, " << ro.out_dir << "/fields.pvd, " << ro.out_dir << "/run.json\n";
@@ -320,8 +343,9 @@ void add_run_command(CLI::App& app, Action& action, const std::string& command) 
   std::string names;
   for (const auto& [name, summary] : integrator_catalogue()) names += "\n  " + name + ": " + summary;
   CLI::App* sub = app.add_subcommand("run", "Integrate a case in time and write history.csv, VTU/PVD and run.json");
-  sub->add_option("case", o->case_path, "Case file (YAML), e.g. apps/cases/flying-plate.yaml")->required();
+  sub->add_option("case", o->case_path, "Case file (YAML), or a case name of apps/cases such as flying-plate")->required();
   sub->add_option("-o,--output", o->out_dir, "Result folder (default: results/<case>/<integrator>)");
+  add_plugin_option(sub, o->plugins);
   sub->add_option("--integrator", o->integrator, "Integrator (default: the case's integrator.name):" + names);
   sub->add_option("--set", o->settings, "Override an integrator setting, KEY=VALUE (repeatable), e.g. --set rho_inf=0.8");
   sub->add_option("--dt", o->dt, "Time step (default: the case's time.dt)");
@@ -349,6 +373,7 @@ int run_resume(const RunCommandOptions& o) {
   check_run_flags(o);
   const std::string dir = o.case_path;
   const Checkpoint c = read_checkpoint((fs::path(dir) / checkpoint_file_name()).string());
+  load_checkpoint_plugins(c);  // the run's plugins, unless given again with --plugin
   // A run killed with SIGKILL leaves its disk reserve (lib/run_info.hpp DiskReserve) behind, and possibly the
   // temporary of an output it was rewriting (run.json, fields.pvd and checkpoint.cbor are written whole to
   // NAME.tmp, then renamed; the complete file from before is still in place). Both are stale: remove them (the
@@ -383,6 +408,7 @@ void add_resume_command(CLI::App& app, Action& action, const std::string& comman
   sub->add_option("--max-wall", o->max_wall, "Stop again after S seconds of wall time in total (default: as before)");
   sub->add_option("--threads", o->threads, "OpenMP threads for element loops (default: all cores)");
   sub->add_flag("-q,--quiet", o->quiet, "No progress lines");
+  add_plugin_option(sub, o->plugins);
   o->cli = sub;
   sub->callback([o, &action] { action = [o] { return run_resume(*o); }; });
 }
@@ -436,9 +462,9 @@ void add_static_command(CLI::App& app, Action& action, const std::string& comman
 // rows with status "failed: ..." in summary.csv/summary.md), 1 for bad input.
 struct CompareCommandOptions {
   std::string case_path, out_dir, reference, command;
-  std::vector<std::string> specs;
+  std::vector<std::string> specs, plugins;
   std::vector<double> dts, rtols;
-  double t_end = -1.0, output_every = 0.0;
+  double t_end = -1.0, output_every = 0.0, progress_every = 10.0;
   int jobs = 2, threads = 0, vtu_every = 0;
   bool no_plots = false, resume = false;
   CLI::App* cli = nullptr;
@@ -467,6 +493,8 @@ int run_compare(const CompareCommandOptions& o) {
   co.reference = o.reference;
   co.command = o.command;
   co.log = &std::cout;
+  if (o.cli->count("--progress-every")) app::check_non_negative("--progress-every", o.progress_every, "--progress-every 10");
+  co.progress_every = o.progress_every;
   const std::string stem = fs::path(co.case_path).stem().string();
   co.out_dir = o.out_dir.empty() ? (fs::path("results") / stem / "compare").string() : o.out_dir;
   const auto runs = expand_compare_runs(co);  // bad specs fail here, before any folder exists
@@ -522,6 +550,10 @@ void add_compare_command(CLI::App& app, Action& action, const std::string& comma
   o->cli = sub;
   sub->add_option("--reference", o->reference, "Label of the reference run for displacement errors (default: finest fixed-step run)");
   sub->add_flag("--no-plots", o->no_plots, "Do not call scripts/plot_compare.py");
+  sub->add_option("--progress-every", o->progress_every,
+                  "A progress line per running run every S seconds of wall time, with its time, steps, wall and CPU "
+                  "seconds (default 10; 0: at every output time)");
+  add_plugin_option(sub, o->plugins);
   sub->callback([o, &action] { action = [o] { return run_compare(*o); }; });
 }
 
@@ -537,6 +569,7 @@ struct StudyCommandOptions {
   double max_wall_per_run = 0.0;
   long long max_steps_per_run = 0;
   bool rerun = false, dry_run = false, report_only = false, no_plots = false;
+  std::vector<std::string> plugins;  // loaded by main()
 };
 
 // The study file `study` names: a shipped study by name, else a file.
@@ -655,6 +688,7 @@ void add_study_command(CLI::App& app, Action& action, const std::string& command
                 "Run nothing; write study.csv, study.md and the plots from the run folders as they are (runs not made "
                 "are listed as not run)");
   sub->add_flag("--no-plots", o->no_plots, "Do not call scripts/plot_study.py");
+  add_plugin_option(sub, o->plugins);
   sub->callback([o, &action] { action = [o] { return run_study_command(*o); }; });
 }
 }  // namespace
@@ -662,6 +696,20 @@ void add_study_command(CLI::App& app, Action& action, const std::string& command
 int main(int argc, char** argv) {
   std::string command;
   for (int k = 0; k < argc; ++k) command += (k ? " " : "") + std::string(argv[k]);
+
+  // Plugins first (integrators/runs/plugin.hpp): SHELLDYN_PLUGINS, then every --plugin PATH / --plugin=PATH, so
+  // that their integrators are known to the option checks and listed by --help. A bad one: one line, exit 1.
+  try {
+    for (const auto& p : plugin_paths_from_environment()) load_plugin(p, "SHELLDYN_PLUGINS");
+    for (int k = 1; k < argc; ++k) {
+      const std::string a = argv[k];
+      if (a == "--plugin" && k + 1 < argc) load_plugin(argv[++k], "--plugin");
+      else if (a.rfind("--plugin=", 0) == 0) load_plugin(a.substr(9), "--plugin");
+    }
+  } catch (const std::exception& e) {
+    app::print_error(std::cerr, "shelldyn: error: ", e.what());
+    return 1;
+  }
 
   CLI::App app{"shelldyn: nonlinear dynamics of thin shells (CR9 shell element, energy-momentum generalized-alpha, "
                "SUNDIALS baselines)"};
@@ -691,6 +739,9 @@ int main(int argc, char** argv) {
     return e.exit_code();
   } catch (const std::exception& e) {
     app::print_error(std::cerr, "shelldyn: error: ", e.what());
+    return 1;
+  } catch (...) {  // e.g. a plugin throwing something that is not a std::exception
+    std::cerr << "shelldyn: error: unknown exception (not a std::exception)\n";
     return 1;
   }
 }

@@ -626,7 +626,7 @@ CaseSpec parse_document(const Parser& p, const YAML::Node& root, const std::stri
   if (!root.IsDefined() || root.IsNull()) p.fail(root, "", "the case file is empty (see apps/cases/ for examples)");
   p.check_keys(root, "",
                {"name", "description", "mesh", "material", "sets", "boundary_conditions", "initial_velocity", "initial_displacement", "loads",
-                "prescribed_displacements", "damping", "integrator", "time", "output", "monitors"},
+                "prescribed_displacements", "damping", "integrator", "time", "output", "monitors", "plugins"},
                {"mesh", "material", "integrator", "time"});
   CaseSpec c;
   c.source = p.source();
@@ -685,6 +685,16 @@ CaseSpec parse_document(const Parser& p, const YAML::Node& root, const std::stri
   c.time = parse_time(p, root["time"]);
   if (root["output"]) c.output = parse_output(p, root["output"]);
   if (root["monitors"]) c.monitors = parse_monitors(p, root["monitors"]);
+  if (root["plugins"]) {  // shared libraries that register integrators (docs/tutorials/05-your-own-integrator.md)
+    const YAML::Node pl = root["plugins"];
+    p.require_sequence(pl, "plugins", "paths of plugin shared libraries (.so)");
+    c.plugins_where = p.where(pl, "plugins");
+    for (size_t k = 0; k < pl.size(); ++k) {
+      fs::path file(p.string(pl[k], "plugins[" + std::to_string(k) + "]"));
+      if (file.is_relative()) file = fs::path(base_dir) / file;
+      c.plugins.push_back(file.lexically_normal().string());
+    }
+  }
   return c;
 }
 

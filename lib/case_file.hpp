@@ -251,6 +251,10 @@ struct CaseSpec {
   TimeSpec time;
   OutputSpec output;
   std::vector<MonitorSpec> monitors;
+  // plugins: [PATH.so, ...]: shared libraries that register integrators, loaded before the integrator is made
+  // (integrators/runs/plugin.hpp); relative paths are resolved against base_dir. plugins_where: "FILE:LINE: plugins".
+  std::vector<std::string> plugins;
+  std::string plugins_where;
 };
 
 // Reads and validates a case file. Throws std::runtime_error ("FILE:LINE: key.path: reason") on

@@ -14,6 +14,7 @@
 #include "elements/cr9_shell.hpp"
 #include "lib/assembler.hpp"
 #include "lib/dof_map.hpp"
+#include "lib/exact_energy_system.hpp"
 #include "lib/mesh.hpp"
 #include "lib/semi_discrete_system.hpp"
 #include "lib/sparse_matrix.hpp"
@@ -46,7 +47,8 @@ struct PrescribedMotion {
   TimeFunction function;
 };
 
-class Model final : public SemiDiscreteSystem {
+// The Model offers the em-exact extension of the system interface (lib/exact_energy_system.hpp).
+class Model final : public ExactEnergySystem {
  public:
   // normals: initial unit nodal normals p_i0 (lib/nodal_normals.hpp). Throws if an element fails the
   // orientation check or the material is invalid (messages name the element).
@@ -111,39 +113,24 @@ class Model final : public SemiDiscreteSystem {
   void damping_force(const Eigen::VectorXd& v, double* out) const override;
   void add_damping_matrix(double c, SparseMatrix& J) const override;
 
-  // ---- Embedded kinematics of the exactly conserving step em-exact (docs/theory/exact-energy-momentum.md) ----
-  // mx = (m ⊗ I₃) x and my = (m ⊗ I₃) y in one element pass: x, y, mx, my hold one 3-vector per node;
-  // m = Σ_e ∫ N_i N_j dA (consistent scalar mass).
+  // ---- ExactEnergySystem: the embedded kinematics of em-exact (lib/exact_energy_system.hpp) ----
+  int num_nodes() const override { return mesh_.num_nodes(); }
+  int num_elements() const override { return mesh_.num_elements(); }
+  double translational_density() const override { return material_.rho * material_.thickness; }
+  double director_density() const override {
+    return material_.rho * material_.thickness * material_.thickness * material_.thickness / 12.0;
+  }
+  bool has_follower_loads() const override { return !follower_.empty(); }
   void scalar_mass_times(const Eigen::VectorXd& x, const Eigen::VectorXd& y, Eigen::VectorXd& mx,
-                         Eigen::VectorXd& my) const;
-  // Strain energy U_e(u_n) of every element at the start u_n of a step (U.size() = number of elements), from the
-  // step's element states (CR9Shell::step_energy(): bitwise the energy a residual evaluated at u_n returns, the
-  // expression the previous step's U(u_{n+1}) used), so no frames or local variables of its own when the step's
-  // states are needed anyway.
-  void step_energies(const Eigen::VectorXd& u_n, const std::vector<DirectorChart>& charts, std::vector<double>& U) const;
-  // Linear local stiffness k_L at the stress-free reference state of element e (symmetric PSD, zero on rigid modes).
-  CR9Shell::Mat45 reference_local_stiffness(int e) const;
-  struct ExactForceInfo {
-    int rigid_guards = 0;     // elements whose step was rigid (β = 0)
-    double max_beta_z = 0.0;  // max over elements of ‖β z‖∞ / ‖F‖∞ (size of the energy correction)
-    double dissipation = 0.0; // Σ_e ξ Δuᵀ G_e Δu ≥ 0 removed by the dissipative force
-  };
-  // The internal force of em-exact (theory §§3, 5): per element the strain-averaged midpoint force
-  // (algorithmic_internal with α_f = ½, ξ = 0) corrected to F* = F + Rᵀa + βz (elements/exact_energy.hpp) so
-  // that R F* = 0 and Δuᵀ F* = U_e(u_np1) − U_n[e]; `correct` = false skips the correction (tests only).
-  // With xi > 0, adds the dissipative force ξ G_e Δu, G_e = Π Tᵀ k0_e T Π (T at u_mid, Π the rigid-complement
-  // projector, k0 = (*k0)[e]). K (optional): the symmetric tangent with respect to u_mid (K_mid of
-  // algorithmic_internal, plus 2ξ G_e so that ½K is its derivative with respect to u_np1).
-  // U_np1 (optional) receives the element energies at u_np1. Returns V(u_np1).
-  // p_mid (optional, 3 per node): the nodal midpoint directors ½(p(u_n) + p(u_np1)) in `charts`, if the caller has
-  // them (em-exact's kinematics); they are not recomputed then (the same expression, so the same values).
+                         Eigen::VectorXd& my) const override;
+  void step_energies(const Eigen::VectorXd& u_n, const std::vector<DirectorChart>& charts,
+                     std::vector<double>& U) const override;
+  CR9Shell::Mat45 reference_local_stiffness(int e) const override;
   double exact_internal(const Eigen::VectorXd& u_n, const Eigen::VectorXd& u_np1, const std::vector<DirectorChart>& charts,
                         const std::vector<double>& U_n, bool correct, double xi,
                         const std::vector<CR9Shell::Mat45>* k0, double* F, SparseMatrix* K,
-                        std::vector<double>* U_np1, ExactForceInfo* info, const Eigen::VectorXd* p_mid = nullptr) const;
-  // Dead loads at time t in embedded form: translational forces Fd and director loads g_i = m_i × p_mid,i
-  // (3 per node each, overwritten); p_mid holds one 3-vector per node.
-  void embedded_external(double t, const Eigen::VectorXd& p_mid, Eigen::VectorXd& Fd, Eigen::VectorXd& g) const;
+                        std::vector<double>* U_np1, ExactForceInfo* info, const Eigen::VectorXd* p_mid = nullptr) const override;
+  void embedded_external(double t, const Eigen::VectorXd& p_mid, Eigen::VectorXd& Fd, Eigen::VectorXd& g) const override;
 
   // Current director of node i.
   Vec3 director(const State& s, int node) const;

@@ -136,6 +136,11 @@ std::string run_json(const CaseSpec& c, const RunInfo& info) {
   v["compiler"] = __VERSION__;
 #endif
   if (!info.overrides.empty()) j["command_line_overrides"] = fields(info.overrides);
+  if (!info.integrator_origin.empty()) j["integrator_origin"] = info.integrator_origin;
+  if (!info.plugins.empty()) {
+    Json& pl = j["plugins"] = Json::array();
+    for (const auto& p : info.plugins) pl.push_back(fields(p));
+  }
 
   Json& cs = j["case"];
   cs["name"] = c.name;

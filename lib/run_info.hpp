@@ -50,6 +50,10 @@ struct RunInfo {
   JsonFields summary;            // e.g. steps, final energy, drift, wall time
   JsonFields overrides;          // command-line flags that changed the case ("command_line_overrides")
   JsonFields checkpoint;         // the last checkpoint written (file, t, step), if any
+  // Where the run's integrator came from ("built-in", a plugin path, ...; "integrator_origin") and the plugins
+  // loaded (path, version, hash, integrators; "plugins", the run's own first). Empty: not written.
+  std::string integrator_origin;
+  std::vector<JsonFields> plugins;
 };
 
 // Encodes a string as a JSON string literal (with quotes).

@@ -6,6 +6,16 @@
 // oscillator of docs/theory.md §7 item 13) so that the integrators' code is checked on problems with
 // exact answers. Evaluations write into caller-owned storage; matrices are unconstrained (the
 // integrator applies dofs() with apply_dirichlet).
+//
+// The contract for integrator authors (docs/reference/system-interface.md, which states it in full):
+//   - evaluations are const and deterministic; only rechart() changes the system (its DofMap);
+//   - Dirichlet rows: every iteration matrix and right-hand side goes through apply_dirichlet(dofs(), J, r), so
+//     constrained entries of u stay put (0, or g(t) for prescribed DOFs) and of v, a at 0 (or the prescribed
+//     rates); read dofs() afresh after each rechart() (director constraints follow the chart);
+//   - chart switches: call rechart() between steps only, never inside a step's iterations; it converts u, v, a
+//     (p, ṗ, p̈ and hence K, V, L, J unchanged) but nothing else the integrator carries in chart coordinates;
+//   - energy: accumulate W_ext (and W_presc, W_damp) consistently with the scheme's own time discretization.
+// em-exact needs more (element energies, embedded directors): the extension lib/exact_energy_system.hpp.
 #pragma once
 
 #include "lib/dof_map.hpp"

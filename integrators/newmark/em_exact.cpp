@@ -9,7 +9,7 @@
 #include "integrators/nonlinear/newton_solver.hpp"
 #include "lib/assembler.hpp"
 #include "lib/linear_solver.hpp"
-#include "lib/model.hpp"
+#include "lib/exact_energy_system.hpp"
 
 #include <algorithm>
 #include <array>
@@ -220,15 +220,15 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
   }
 
   void initialize(SemiDiscreteSystem& sys, State& s) override {
-    model_ = dynamic_cast<Model*>(&sys);
+    model_ = dynamic_cast<ExactEnergySystem*>(&sys);
     if (!model_)
-      throw std::invalid_argument("em-exact: needs the CR9 shell Model (embedded director velocities); got another system");
+      throw std::invalid_argument("em-exact: needs a system with the ExactEnergySystem extension (lib/exact_energy_system.hpp: embedded director velocities, element energies), such as the CR9 shell Model; got another system");
     // Its embedded formulation takes nodal dead loads only (docs/manual.md §2.7–2.8): refuse what it would ignore.
-    if (model_->has_damping() || !model_->follower_pressures().empty())
+    if (model_->has_damping() || model_->has_follower_loads())
       throw std::invalid_argument("em-exact: Rayleigh damping and follower pressures are not supported by this "
                                   "integrator (use em-galpha, or remove 'damping' / the follower_pressure loads)");
     const Index n = sys.num_dofs();
-    nn_ = model_->mesh().num_nodes();
+    nn_ = model_->num_nodes();
     // certify = auto (constructor): resolved here, where the system is known; run.json records the result.
     use_certify(certify_ != "auto"        ? certify_
                 : !nopt_.modified             ? "residual"
@@ -236,7 +236,7 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
                                               : "predicted");
     newton_ = std::make_unique<NewtonSolver>(sys.pattern(), nopt_);
     full_newton_.reset();
-    M_ = model_->make_matrix();
+    M_ = SparseMatrix{sys.pattern(), std::vector<double>(static_cast<size_t>(sys.pattern()->nnz()), 0.0)};
     K_ = M_;
     for (Eigen::VectorXd* v : {&un_, &umid_, &fint_, &r_, &last_u_}) v->setZero(n);
     for (Eigen::VectorXd* v : {&wdot_, &an_, &wan_, &vn_, &wn_, &pn_, &p1_, &pmid_, &v1_, &w1_, &dv_, &dw_, &mv_, &mw_, &fd_, &g_}) v->setZero(3 * nn_);
@@ -261,8 +261,8 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
     if (newmark_predictor_) start_newmark_recursion(s);
     k0_.clear();
     if (xi_ > 0.0) {
-      k0_.resize(static_cast<size_t>(model_->mesh().num_elements()));
-      for (int e = 0; e < model_->mesh().num_elements(); ++e) k0_[static_cast<size_t>(e)] = model_->reference_local_stiffness(e);
+      k0_.resize(static_cast<size_t>(model_->num_elements()));
+      for (int e = 0; e < model_->num_elements(); ++e) k0_[static_cast<size_t>(e)] = model_->reference_local_stiffness(e);
     }
   }
 
@@ -362,8 +362,7 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
       v1_.segment<3>(3 * i) = (2.0 / h) * (u.segment<3>(k) - un_.segment<3>(k)) - vn_.segment<3>(3 * i);
     }
     w1_ = (2.0 / h) * (p1_ - pn_) - wn_;
-    const ShellMaterial& mat = model_->material();
-    const double rh = mat.rho * mat.thickness, rh3 = rh * mat.thickness * mat.thickness / 12.0;
+    const double rh = model_->translational_density(), rh3 = model_->director_density();  // ρh, ρh³/12
     dv_ = v1_ - vn_;
     dw_ = w1_ - wn_;
     model_->scalar_mass_times(dv_, dw_, mv_, mw_);
@@ -373,7 +372,7 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
   }
 
   bool step(State& s, double h, StepReport& rep, std::string* why, bool full_newton = false) {
-    Model& sys = *model_;
+    ExactEnergySystem& sys = *model_;
     rep.chart_switches += sys.rechart(s, hysteresis_);  // between steps only; d, p, v, w unchanged
     kept_.start_step(h, *newton_);  // K̄ depends on h
     if (full_newton && !full_newton_) {
@@ -393,7 +392,7 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
 
     std::vector<double> history;  // scaled residual of every evaluated iterate
     double best = std::numeric_limits<double>::infinity();
-    Model::ExactForceInfo finfo;
+    ExactEnergySystem::ExactForceInfo finfo;
     int last_jacobian_iter = 0;
 
     auto residual = [&](const double* up, double* rp) {
@@ -572,7 +571,7 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
     // Final quantities at the accepted iterate.
     kinematics(u, charts, h, tmid);
     if (xi_ > 0.0) {
-      Model::ExactForceInfo fi;
+      ExactEnergySystem::ExactForceInfo fi;
       sys.exact_internal(un_, u, charts, Un_, correction_, xi_, &k0_, fint_.data(), nullptr, nullptr, &fi, &pmid_);
       diag_.dissipation += fi.dissipation;
       diag_.min_step_dissipation = std::min(diag_.min_step_dissipation, fi.dissipation);
@@ -652,11 +651,11 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
   std::array<double, kFloorSteps> recent_floor_{};
   std::vector<std::pair<std::string, std::string>> resolved_;
 
-  Model* model_ = nullptr;
+  ExactEnergySystem* model_ = nullptr;
   int nn_ = 0;
   std::unique_ptr<NewtonSolver> newton_, full_newton_;
   SparseMatrix M_, K_;
-  std::vector<CR9Shell::Mat45> k0_;
+  std::vector<ExactEnergySystem::ElementStiffness> k0_;
   std::vector<double> Un_;
   // The last step's director accelerations (w_{n+1} − w_n)/Δt in ℝ³ (3 per node; 0 before the first step): the
   // predictor's ẇ_n. Chart-free, so a chart switch between steps does not touch it; saved in checkpoints.

@@ -1,5 +1,6 @@
 #include "integrators/runs/case_integrator.hpp"
 
+#include "integrators/runs/plugin.hpp"
 #include "integrators/runs/registry.hpp"
 
 #include <cctype>
@@ -28,9 +29,15 @@ std::string strip_prefix(const std::string& msg, const std::string& key) {
 
 }  // namespace
 
+void load_case_plugins(const CaseSpec& spec) {
+  for (size_t k = 0; k < spec.plugins.size(); ++k)
+    load_plugin(spec.plugins[k], spec.plugins_where.empty() ? "" : spec.plugins_where + "[" + std::to_string(k) + "]");
+}
+
 std::unique_ptr<Integrator> make_case_integrator(const CaseSpec& spec, const std::string& integrator,
                                                  const std::vector<std::pair<std::string, std::string>>& overrides,
                                                  double dt) {
+  load_case_plugins(spec);
   const bool own = integrator.empty() || integrator == spec.integrator.name;
   const std::string name = own ? spec.integrator.name : integrator;
   if (name == "static") throw std::invalid_argument("integrator 'static' is the static solver: use `shelldyn static CASE`");

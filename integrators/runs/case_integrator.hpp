@@ -25,6 +25,10 @@ std::unique_ptr<Integrator> make_case_integrator(const CaseSpec& spec, const std
                                                  const std::vector<std::pair<std::string, std::string>>& overrides,
                                                  double dt);
 
+// Loads the plugins of the case file's `plugins:` key (integrators/runs/plugin.hpp); make_case_integrator calls it.
+// Throws PluginError "FILE:LINE: plugins[k]: plugin PATH: ...".
+void load_case_plugins(const CaseSpec& spec);
+
 // make_case_integrator(spec, "", {}, spec.time.dt), result discarded ("static" passes: it is checked
 // by the static solver, except that it refuses prescribed displacement histories).
 void validate_case_integrator(const CaseSpec& spec);

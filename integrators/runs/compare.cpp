@@ -186,8 +186,9 @@ std::vector<CompareRun> expand_compare_runs(const CompareOptions& o) {
     if (!(dt > 0.0) || !std::isfinite(dt)) throw std::invalid_argument("--dt: every time step must be > 0 (got " + num(dt) + ")");
   for (double r : o.rtols)
     if (!(r > 0.0) || !std::isfinite(r)) throw std::invalid_argument("--rtol: every tolerance must be > 0 (got " + num(r) + ")");
-  const auto names = integrator_names();
   const CaseSpec case_spec = load_case(o.case_path);
+  load_case_plugins(case_spec);  // its integrators are then valid names below
+  const auto names = integrator_names();
   std::vector<CompareRun> runs;
   for (const auto& spec : o.specs) {
     CompareRun base = parse_compare_spec(spec);
@@ -274,6 +275,7 @@ std::string encode_outcome(const RunSummary& s, double energy_error) {
      << " " << full(s.H_final) << " " << full(s.max_rel_drift) << " " << full(s.final_rel_drift) << " " << full(s.max_dL) << " "
      << full(s.max_dJ) << " " << full(s.ref_L) << " " << full(s.ref_J) << " " << full(s.max_strain_ratio) << " "
      << full(s.wall_seconds) << " " << full(energy_error) << "\n";
+  os << "cpu " << full(s.cpu_seconds) << "\n";
   os << "damping " << (s.damped ? 1 : 0) << " " << full(s.damping_work) << "\n";
   for (const auto& [name, v] : s.final_monitors) os << "monitor " << full(v) << " " << name << "\n";
   os << "end\n";
@@ -313,6 +315,8 @@ void decode_outcome(const std::string& text, RunSummary& s, double& energy_error
       for (double* p : {&s.t_end, &s.H0, &s.H_ref, &s.E_ref, &s.t_ref, &s.H_final, &s.max_rel_drift, &s.final_rel_drift,
                         &s.max_dL, &s.max_dJ, &s.ref_L, &s.ref_J, &s.max_strain_ratio, &s.wall_seconds, &energy_error})
         *p = read_number(ls);
+    } else if (key == "cpu") {
+      s.cpu_seconds = read_number(ls);
     } else if (key == "damping") {
       s.damped = read_number(ls) != 0.0;
       s.damping_work = read_number(ls);
@@ -413,7 +417,7 @@ void write_compare_summaries(const CompareOptions& o, const Problem& first, doub
     std::ofstream csv(result.summary_csv + ".tmp");  // then renamed: a reader never sees half a file
     if (!csv) throw std::runtime_error(result.summary_csv + ": cannot write");
     csv << "label,integrator,overrides,settings,dt,t_end,steps,rejected_steps,nonlinear_iterations,linear_setups,"
-           "factorizations,rhs_evaluations,chart_switches,wall_s,t_ref,energy_error,max_rel_drift_of_H,"
+           "factorizations,rhs_evaluations,chart_switches,wall_s,cpu_s,t_ref,energy_error,max_rel_drift_of_H,"
            "max_dL,max_dJ,norm_L_ref,norm_J_ref";
     for (const auto& m : result.monitors) csv << ",final_" << m;
     csv << ",displacement_error,reference,status\n";
@@ -425,7 +429,7 @@ void write_compare_summaries(const CompareOptions& o, const Problem& first, doub
         csv << csv_field(settings_text(s.settings, ";")) << "," << full(dt) << "," << full(s.t_end) << "," << s.totals.steps
             << "," << s.totals.rejected_steps << "," << s.totals.nonlinear_iterations << "," << s.totals.linear_setups << ","
             << s.totals.factorizations << "," << s.totals.rhs_evaluations << "," << s.totals.chart_switches << ","
-            << full(s.wall_seconds) << "," << full(s.t_ref) << "," << full(r.energy_error) << ","
+            << full(s.wall_seconds) << "," << full(s.cpu_seconds) << "," << full(s.t_ref) << "," << full(r.energy_error) << ","
             << full(t_end >= loads_end ? s.max_rel_drift : std::nan("")) << "," << full(s.max_dL) << "," << full(s.max_dJ)
             << "," << full(s.ref_L) << "," << full(s.ref_J);
         for (const auto& m : result.monitors) {
@@ -436,7 +440,7 @@ void write_compare_summaries(const CompareOptions& o, const Problem& first, doub
         }
       } else {
         csv << "," << full(dt) << "," << full(t_end);
-        for (int k = 0; k < 15; ++k) csv << ",";
+        for (int k = 0; k < 16; ++k) csv << ",";
         for (size_t k = 0; k < result.monitors.size(); ++k) csv << ",";
       }
       csv << "," << full(r.displacement_error) << "," << csv_field(result.reference) << "," << csv_field(r.status) << "\n";
@@ -466,9 +470,9 @@ void write_compare_summaries(const CompareOptions& o, const Problem& first, doub
     for (size_t k = 0; k < result.monitors.size(); ++k) md << (k ? ", " : "") << result.monitors[k];
     md << "); reference run: " << (result.reference.empty() ? std::string("none (no completed run)") : "`" + result.reference + "`")
        << "\n\n";
-    md << "| run | dt | steps | Newton iters | factorizations | wall [s] | energy error | max ‖ΔL‖ | max ‖ΔJ‖ | final " << mon
+    md << "| run | dt | steps | Newton iters | factorizations | wall [s] | CPU [s] | energy error | max ‖ΔL‖ | max ‖ΔJ‖ | final " << mon
        << " | displ. error | status |\n";
-    md << "|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+    md << "|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
     for (const auto& r : result.rows) {
       const RunSummary& s = r.summary;
       const double dt = r.run.dt > 0.0 ? r.run.dt : first.spec.time.dt;
@@ -478,11 +482,11 @@ void write_compare_summaries(const CompareOptions& o, const Problem& first, doub
         for (const auto& [name, value] : s.final_monitors)
           if (name == mon) final_mon = value;
         md << s.totals.steps << " | " << s.totals.nonlinear_iterations << " | " << s.totals.factorizations << " | "
-           << num(s.wall_seconds) << " | " << (std::isnan(r.energy_error) ? "n/a" : num(r.energy_error)) << " | "
+           << num(s.wall_seconds) << " | " << num(s.cpu_seconds) << " | " << (std::isnan(r.energy_error) ? "n/a" : num(r.energy_error)) << " | "
            << num(s.max_dL) << " | " << num(s.max_dJ) << " | " << num(final_mon) << " | "
            << (std::isnan(r.displacement_error) ? "n/a" : num(r.displacement_error)) << " | complete |\n";
       } else {
-        md << "– | – | – | – | – | – | – | – | – | " << md_cell(r.status) << " |\n";
+        md << "– | – | – | – | – | – | – | – | – | – | " << md_cell(r.status) << " |\n";
       }
     }
     md.close();
@@ -571,6 +575,17 @@ struct Sweep {
     ro.log = &runlog;
     ro.command = o.command + "  [run " + run.label + "]";
     ro.label = run.label;
+    if (log && o.progress_every >= 0.0) {  // the console sees each run advance (its full log is log.txt)
+      ro.progress_every = o.progress_every;
+      const std::string prefix = o.log_prefix;
+      std::ostream* out = log;
+      ro.progress = [out, prefix](const std::string& line) {
+        static std::mutex m;
+        const std::string text = "  " + prefix + line + "\n";
+        std::lock_guard<std::mutex> lock(m);
+        *out << text << std::flush;
+      };
+    }
     const RunSummary summary = run_dynamic(problem, ro);
     print_run_summary(runlog, summary);
     const double energy_error =
@@ -604,7 +619,7 @@ struct Sweep {
         decode_outcome(payload, row.summary, row.energy_error);
         if (log)
           *log << tag << o.log_prefix << row.run.label << ": " << row.summary.totals.steps << " steps, "
-               << num(row.summary.wall_seconds) << " s, "
+               << num(row.summary.wall_seconds) << " s wall, " << num(row.summary.cpu_seconds) << " s CPU, "
                << (std::isnan(row.energy_error) ? std::string("no energy error after the loads (the run ends while they act)")
                                                 : "energy error after the loads " + num(row.energy_error))
                << (reused ? " (reused: --resume found it finished with the same settings)" : "") << std::endl;

@@ -71,6 +71,9 @@ struct CompareOptions {
   std::string out_dir;              // required
   std::string reference;            // label of the reference run (empty: automatic, see above)
   std::ostream* log = nullptr;      // one line per run start/finish
+  // Progress of the runs on `log` (each run's own progress lines go to its log.txt): one line "LABEL | t = ..."
+  // per run every progress_every seconds of wall time (and at its first and last output); < 0: none.
+  double progress_every = 10.0;
   std::string command;              // recorded in run.json and summary.md
   std::string log_prefix;           // put before run labels in log lines (run_comparisons: e.g. "window/")
 };

@@ -2,6 +2,7 @@
 #include "integrators/runs/case_integrator.hpp"
 #include "integrators/runs/registry.hpp"
 
+#include "integrators/runs/plugin.hpp"
 #include "integrators/sundials/sundials_info.hpp"
 #include "lib/history_writer.hpp"
 #include "lib/reactions.hpp"
@@ -11,6 +12,7 @@
 #include <omp.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <csignal>
@@ -48,12 +50,15 @@ void fill_summary_json(JsonFields& j, const RunSummary& s) {
   j.set("H_final", s.H_final);
   if (s.damped) j.set("damping_work", s.damping_work);
   if (s.prescribed) j.set("prescribed_work", s.prescribed_work);
-  j.set("max_rel_energy_drift_after_loads", s.max_rel_drift);
-  j.set("final_rel_energy_drift", s.final_rel_drift);
-  j.set("max_abs_dL_after_loads", s.max_dL);
-  j.set("max_abs_dJ_after_loads", s.max_dJ);
-  j.set("norm_L_ref", s.ref_L);
-  j.set("norm_J_ref", s.ref_J);
+  // A run that ends while the loads act has no "after the loads" figures: null, not 0 (which reads as exact).
+  const double nan = std::nan("");
+  j.set("loads_still_on_at_end", !s.after_loads);
+  j.set("max_rel_energy_drift_after_loads", s.after_loads ? s.max_rel_drift : nan);
+  j.set("final_rel_energy_drift", s.after_loads ? s.final_rel_drift : nan);
+  j.set("max_abs_dL_after_loads", s.after_loads ? s.max_dL : nan);
+  j.set("max_abs_dJ_after_loads", s.after_loads ? s.max_dJ : nan);
+  j.set("norm_L_ref", s.after_loads ? s.ref_L : nan);
+  j.set("norm_J_ref", s.after_loads ? s.ref_J : nan);
   j.set("max_strain_over_energy", s.max_strain_ratio);
   for (const auto& [name, value] : s.final_monitors) j.set("final_" + name, value);
   j.set("wall_s", s.wall_seconds);
@@ -198,6 +203,35 @@ CheckpointPolicy default_checkpoint_policy() {
   return p;
 }
 
+void load_checkpoint_plugins(const Checkpoint& c) {
+  if (!c.texts.count("plugins")) return;  // a checkpoint from before plugins were recorded
+  const std::string wanted = c.texts.count("integrator_registered") ? c.text("integrator_registered") : c.integrator;
+  const auto registered = [&wanted] {
+    const auto names = integrator_names();
+    return std::find(names.begin(), names.end(), wanted) != names.end();
+  };
+  std::istringstream in(c.text("plugins"));
+  for (std::string line; !registered() && std::getline(in, line);) {  // given again with --plugin: nothing to load
+    if (line.empty()) continue;
+    const auto t1 = line.find('\t');
+    const auto t2 = t1 == std::string::npos ? t1 : line.find('\t', t1 + 1);
+    const std::string path = line.substr(0, t1);
+    const std::string version = t1 == std::string::npos ? "unknown" : line.substr(t1 + 1, t2 == std::string::npos ? t2 : t2 - t1 - 1);
+    const std::string hash = t2 == std::string::npos ? "" : line.substr(t2 + 1);
+    std::error_code ec;
+    if (!std::filesystem::exists(path, ec))
+      throw PluginError("resume: plugin " + path + " (version " + version + ", " + hash + "), recorded for this run's integrator '" +
+                        wanted + "', is missing: rebuild it there or give it with --plugin PATH");
+    const PluginInfo p = load_plugin(path, "resume");
+    if (!hash.empty() && p.hash != hash)
+      std::cerr << "warning: plugin " << path << " changed since the checkpoint (" << hash << ", now " << p.hash
+                << "); the continued run may differ from an uninterrupted one" << std::endl;
+  }
+  if (!registered())
+    throw PluginError("resume: integrator '" + wanted + "' of this run is not registered and no recorded plugin provides it; "
+                      "give its plugin with --plugin PATH");
+}
+
 Problem problem_from_checkpoint(const Checkpoint& c) {
   CaseSpec spec = load_case_from_string(c.text("case_text"), c.text("case_source"), c.text("case_base_dir"));
   if (const auto* m = std::get_if<MeshFileSpec>(&spec.mesh)) {
@@ -267,6 +301,11 @@ RunSummary run_dynamic(Problem& problem, const RunOptions& o) {
   if (!(o.max_wall >= 0.0) || !std::isfinite(o.max_wall)) throw std::invalid_argument("max_wall must be >= 0");
   const int vtu_every = o.vtu_every >= 0 ? o.vtu_every : (spec.output.vtu ? spec.output.vtu_every : 0);
   std::unique_ptr<Integrator> integrator = make_case_integrator(spec, o.integrator, o.settings, dt);
+  // Where the integrator came from (registry.hpp): a plugin's failures are reported with its path.
+  const std::string registered_name = o.integrator.empty() ? spec.integrator.name : o.integrator;
+  const std::string origin = integrator_origin(registered_name);
+  const std::optional<PluginInfo> plugin = plugin_of_integrator(registered_name);
+  const std::string blame = origin == "built-in" ? std::string() : "integrator '" + registered_name + "' from " + origin + ": ";
 
   RunSummary sum;
   sum.integrator = integrator->name();
@@ -289,6 +328,18 @@ RunSummary run_dynamic(Problem& problem, const RunOptions& o) {
   info.sundials_version = sundials_version();
   info.status = "incomplete: running";  // what a killed run leaves (with its last checkpoint)
   for (const auto& [k, v] : o.overrides) info.overrides.set(k, v);
+  info.integrator_origin = origin;
+  for (const auto& p : loaded_plugins()) {  // every plugin of the process (run.json "plugins"), the run's first
+    JsonFields f;
+    f.set("path", p.path);
+    f.set("version", p.version);
+    f.set("hash", p.hash);
+    std::string names;
+    for (const auto& n : p.integrators) names += (names.empty() ? "" : ",") + n;
+    f.set("integrators", names);
+    if (plugin && p.path == plugin->path) info.plugins.insert(info.plugins.begin(), f);
+    else info.plugins.push_back(f);
+  }
   info.discretization.set("nodes", model.mesh().num_nodes());
   info.discretization.set("elements", model.mesh().num_elements());
   info.discretization.set("dofs", static_cast<long long>(model.num_dofs()));
@@ -332,9 +383,10 @@ RunSummary run_dynamic(Problem& problem, const RunOptions& o) {
   sum.settings = integrator->settings();
   spec.integrator.settings = sum.settings;
   const double loads_end = model.loads_end();
+  sum.loads_end = loads_end;
   bool have_ref = false;
   Eigen::Vector3d L_ref = Eigen::Vector3d::Zero(), J_ref = Eigen::Vector3d::Zero();
-  double last_print = -1.0;
+  double last_print = -1.0, last_progress = -1.0;
   long long out_index = 0, k_next = 1;
   bool line_open = false;
   double next_plain_t = 0.0;
@@ -353,6 +405,7 @@ RunSummary run_dynamic(Problem& problem, const RunOptions& o) {
     sum.settings = integrator->settings();
     spec.integrator.settings = sum.settings;
     DriverNumbers{sum, have_ref, out_index, k_next, E_seen}.each([&](const char* key, double& x) { x = resume->number(key); });
+    sum.after_loads = have_ref;
     L_ref = resume->vector("L_ref");
     J_ref = resume->vector("J_ref");
     wall_before = resume->number("wall_s");
@@ -377,7 +430,7 @@ RunSummary run_dynamic(Problem& problem, const RunOptions& o) {
       IntegratorCheckpoint probe;
       integrator->save(probe);
     } catch (const std::exception& e) {
-      if (policy.requested && policy.enabled()) throw std::invalid_argument(std::string(e.what()));
+      if (policy.requested && policy.enabled()) throw std::invalid_argument(blame + e.what());
       can_checkpoint = false;
       if (o.log && policy.enabled()) *o.log << "note: " << e.what() << "; this run writes no checkpoints" << std::endl;
     }
@@ -429,6 +482,13 @@ RunSummary run_dynamic(Problem& problem, const RunOptions& o) {
     c.texts["label"] = o.label;
     c.texts["command"] = o.command;
     c.texts["checkpoint_policy"] = policy.text();
+    {  // the plugins loaded (path, version, hash per line), for load_checkpoint_plugins()
+      std::string pl;
+      for (const auto& p : loaded_plugins()) pl += p.path + "\t" + p.version + "\t" + p.hash + "\n";
+      c.texts["plugins"] = pl;
+      c.texts["integrator_origin"] = origin;
+      c.texts["integrator_registered"] = registered_name;
+    }
     c.numbers["max_steps"] = static_cast<double>(o.max_steps);
     c.numbers["max_wall"] = o.max_wall;
     write_checkpoint(checkpoint_path, c);
@@ -447,6 +507,7 @@ RunSummary run_dynamic(Problem& problem, const RunOptions& o) {
     if (out_index == 0) sum.H0 = H;
     if (!have_ref && state.t >= loads_end - 1e-12 * dt) {
       have_ref = true;
+      sum.after_loads = true;
       sum.H_ref = H;
       // Scale of relative drifts: the energy the body holds then (K + V). H itself can be ~0 (a body
       // started at rest holds exactly the work done on it, H = K + V − W_ext ≈ 0).
@@ -527,6 +588,15 @@ RunSummary run_dynamic(Problem& problem, const RunOptions& o) {
       } else {
         *o.log << buf << std::endl;
       }
+    }
+    if (o.progress && (last || out_index == 0 || wall - last_progress >= o.progress_every)) {
+      last_progress = wall;
+      const double eta = state.t > 0.0 ? wall * (t_end - state.t) / state.t : 0.0;
+      char buf[320];
+      std::snprintf(buf, sizeof buf, "%s | t = %.6g/%.6g  steps %ld  iters %ld  %s %+.2e  wall %.1f s  CPU %.1f s  ETA %.0f s",
+                    o.label.empty() ? sum.integrator.c_str() : o.label.c_str(), state.t, t_end, sum.totals.steps,
+                    sum.totals.nonlinear_iterations, have_ref ? "drift" : "balance (loads on)", drift, wall, cpu_used(), eta);
+      o.progress(buf);
     }
     if (last)
       for (size_t k = 0; k < monitors.size(); ++k) sum.final_monitors.emplace_back(monitors[k].name, mon[k]);
@@ -622,9 +692,14 @@ RunSummary run_dynamic(Problem& problem, const RunOptions& o) {
     throw;
   } catch (const std::exception& e) {
     if (line_open) *o.log << std::endl;  // end the in-place status line before the error message
-    const std::string json_error = write_status(std::string("incomplete: ") + e.what(), true);
-    if (!json_error.empty()) throw std::runtime_error(std::string(e.what()) + "; " + json_error);
+    const std::string json_error = write_status(std::string("incomplete: ") + blame + e.what(), true);
+    if (!json_error.empty()) throw std::runtime_error(blame + e.what() + "; " + json_error);
+    if (!blame.empty()) throw std::runtime_error(blame + e.what());  // names the plugin (integrators/runs/plugin.hpp)
     throw;
+  } catch (...) {  // a plugin may throw anything
+    const std::string what = blame + "threw a non-standard exception";
+    write_status("incomplete: " + what, true);
+    throw std::runtime_error(what);
   }
   if (files) {
     std::error_code ec;
@@ -660,9 +735,15 @@ void print_run_summary(std::ostream& out, const RunSummary& s) {
        num(s.H0) + ", " + num(s.H_ref) + " (at t = " + num(s.t_ref) + ")");
   if (s.damped) line("damping work W_damp (end)", num(s.damping_work));
   if (s.prescribed) line("prescribed-motion work W_presc (end)", num(s.prescribed_work));
-  line("max |H - H_ref|/(K+V)_ref after loads", num(s.max_rel_drift));
-  line("max |L - L_ref| after loads", num(s.max_dL) + " (|L_ref| = " + num(s.ref_L) + ")");
-  line("max |J - J_ref| after loads", num(s.max_dJ) + " (|J_ref| = " + num(s.ref_J) + ")");
+  if (s.after_loads) {
+    line("max |H - H_ref|/(K+V)_ref after loads", num(s.max_rel_drift));
+    line("max |L - L_ref| after loads", num(s.max_dL) + " (|L_ref| = " + num(s.ref_L) + ")");
+    line("max |J - J_ref| after loads", num(s.max_dJ) + " (|J_ref| = " + num(s.ref_J) + ")");
+  } else {  // not 0: nothing was measured after the loads
+    const std::string na = "n/a (loads still on: the run ends at t = " + num(s.t_end) + ", the loads at t = " + num(s.loads_end) + ")";
+    line("max |H - H_ref|/(K+V)_ref after loads", na);
+    line("max |L - L_ref|, |J - J_ref| after loads", "n/a");
+  }
   for (const auto& [name, value] : s.final_monitors) line("final " + name, num(value));
   line("wall time [s]", num(s.wall_seconds));
   line("CPU time [s]", num(s.cpu_seconds));

@@ -40,6 +40,7 @@
 #include "integrators/integrator.hpp"
 #include "lib/problem.hpp"
 
+#include <functional>
 #include <stdexcept>
 
 #include <ostream>
@@ -87,6 +88,10 @@ struct RunOptions {
   std::ostream* log = nullptr;     // progress lines and the final summary
   std::string command;             // recorded in run.json
   std::string label;               // optional label printed in progress lines (e.g. "FLP-prov")
+  // Besides `log`: one plain progress line (as in `log`, label first) every `progress_every` seconds of wall time
+  // (0: at every output time) handed to `progress`, e.g. the console of `shelldyn compare` whose runs log to files.
+  std::function<void(const std::string& line)> progress;
+  double progress_every = 10.0;
   CheckpointPolicy checkpoint;     // default: none (the CLI and the apps use default_checkpoint_policy())
   long long max_steps = 0;         // stop at the first output time with at least this many steps; 0: none
   double max_wall = 0.0;           // stop after this many seconds of wall time; 0: none
@@ -111,6 +116,10 @@ struct RunSummary {
   double t_end = 0.0;
   StepReport totals;
   double H0 = 0.0, H_ref = 0.0, E_ref = 0.0, t_ref = 0.0, H_final = 0.0;  // E_ref = (K + V) at t_ref
+  // false when the run ended before the loads did (t_end < loads_end): the "after the loads" figures below are
+  // then NaN (run.json: null; printed "n/a (loads still on)"), not 0.
+  bool after_loads = false;
+  double loads_end = 0.0;          // the system's loads_end()
   double max_rel_drift = 0.0;      // max |H − H_ref|/E_ref for t ≥ t_ref
   double final_rel_drift = 0.0;
   double max_dL = 0.0, max_dJ = 0.0;          // max ‖L − L_ref‖, ‖J − J_ref‖ for t ≥ t_ref
@@ -131,6 +140,11 @@ struct RunSummary {
 };
 
 RunSummary run_dynamic(Problem& problem, const RunOptions& options);
+
+// `shelldyn resume`: makes sure the integrator of checkpoint `c` is registered, loading the plugins the run
+// recorded (integrators/runs/plugin.hpp) unless they are loaded already (e.g. given again with --plugin).
+// Throws PluginError naming the plugin (path, version, hash) and how to provide it when it cannot be loaded.
+void load_checkpoint_plugins(const Checkpoint& c);
 
 // Prints the summary block the CLI and the apps show at the end of a run.
 void print_run_summary(std::ostream& out, const RunSummary& s);

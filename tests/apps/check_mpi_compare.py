@@ -7,7 +7,7 @@ usage: check_mpi_compare.py same SHELLDYN MPIEXEC OUT_DIR
 
 same: a flying-plate sweep of 5 runs (one fails by design) once in one process (--jobs 2) and once under
       `mpirun -n 4 --oversubscribe`;
-      summary.csv must agree in every column except wall_s (runs are single-threaded and independent, so
+      summary.csv must agree in every column except wall_s and cpu_s (runs are single-threaded and independent, so
       the numbers are bit-identical), summary.md in every table cell except wall [s], and the MPI log
       must show runs on at least two ranks.
 kill: `mpirun -n 3` on a sweep of two long and two short runs; when the short ones have finished, a rank
@@ -62,7 +62,7 @@ def md_rows(d):
     out = []
     for l in lines:
         cells = [c.strip() for c in l.strip().strip("|").split("|")]
-        del cells[5]  # wall [s]
+        del cells[5:7]  # wall [s], CPU [s]
         out.append(cells)
     return out
 
@@ -82,10 +82,10 @@ def same(exe, mpiexec, out):
         if not ra["status"].startswith(want) or not rb["status"].startswith(want):
             fail(f"{ra['label']}: status {ra['status']!r} / {rb['status']!r}, expected {want!r}")
         for col in ra:
-            if col != "wall_s" and ra[col] != rb[col]:
+            if col not in ("wall_s", "cpu_s") and ra[col] != rb[col]:
                 fail(f"{ra['label']}: column {col}: single {ra[col]!r}, mpirun -n 4 {rb[col]!r}")
     if md_rows(out + "/single") != md_rows(out + "/mpi4"):
-        fail("summary.md tables differ (wall column excluded)")
+        fail("summary.md tables differ (wall and CPU columns excluded)")
     ranks = set(re.findall(r"complete \(rank (\d)\)", log))
     if len(ranks) < 2:
         fail(f"runs finished on ranks {sorted(ranks)}: the sweep was not distributed")
