@@ -224,7 +224,12 @@ void check_range(const std::string& flag, long long value, long long lo, long lo
                                 std::to_string(hi) + ", e.g. " + example);
 }
 
-void print_error(std::ostream& err, const std::string& prefix, const std::string& what) {
+void print_error(std::ostream& err, const std::string& prefix, const std::string& what_in) {
+  // A bare std::bad_alloc (an allocation the memory estimate did not foresee) says what it means.
+  const std::string what = what_in == "std::bad_alloc"
+                               ? "out of memory (" + memory_text(static_cast<double>(available_memory_bytes())) +
+                                     " available); use a coarser mesh or fewer runs at a time (--jobs)"
+                               : what_in;
   std::istringstream in(what);
   std::string line;
   bool first = true;

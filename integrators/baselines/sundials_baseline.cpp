@@ -177,9 +177,13 @@ StepReport SundialsBaseline::advance(SemiDiscreteSystem& system, State& state, d
     if (taken > guard || below >= 1000.0) {
       add_counters(rep);
       std::ostringstream os;
-      os << name_ << ": crawling at t = " << t_ << ": step size " << last_step() << ", " << taken << " steps since t = " << t_start
-         << ", below dt_min = " << dt_min << " (the load or stiffness is beyond these tolerances; raise rtol, set dt_min or "
-         << "use a fixed-step integrator)";
+      os.precision(3);
+      os << name_ << ": crawling at t = " << t_ << " (";
+      if (below >= 1000.0)
+        os << "1000 steps in a row below dt_min = " << dt_min << ", the last " << last_step();
+      else
+        os << taken << " steps since t = " << t_start << ", more than the interval / dt_min = " << dt_min;
+      os << "); raise rtol, lower dt_min or use a fixed-step integrator";
       throw StepFailure(os.str());
     }
     const StepOutcome what = outcome(flag);

@@ -3,8 +3,8 @@
 
 usage: check_checkpoint_integrity.py SHELLDYN CASE WORK_DIR MODE [N]
 
-MODE = kill   N (default 20) runs with a checkpoint after every output, each killed with SIGKILL at a random
-              time (most of a step's time is its checkpoint write), then `resume` (again after every further
+MODE = kill   N (default 20) runs with a checkpoint after every output, each killed with SIGKILL while it
+              writes a checkpoint (at the first checkpoint.cbor.tmp seen after a random delay), then `resume` (again after every further
               kill-free attempt, until complete): every history.csv must equal the uninterrupted run's, row for
               row in every column but wall_s. Prints how many kills hit a checkpoint write (its .tmp left).
 MODE = flips  N (default 100) copies of a stopped run (--max-steps), each with one random bit of
@@ -61,7 +61,12 @@ def main():
                 deadline = time.time() + 120
                 while not os.path.exists(os.path.join(d, "checkpoint.cbor")) and p.poll() is None and time.time() < deadline:
                     time.sleep(0.001)
-                time.sleep(random.uniform(0.0, 0.6 * run_time))
+                time.sleep(random.uniform(0.0, 0.5 * run_time))
+                # Then at the next checkpoint write (its temporary exists while it is written and synced).
+                tmp = os.path.join(d, "checkpoint.cbor.tmp")
+                deadline = time.time() + 5
+                while not os.path.exists(tmp) and p.poll() is None and time.time() < deadline:
+                    pass
                 p.send_signal(signal.SIGKILL)
                 p.wait()
                 if os.path.exists(os.path.join(d, "checkpoint.cbor")):
