@@ -1,4 +1,5 @@
 #include "apps/app_common.hpp"
+#include "lib/result_folder.hpp"
 
 #include "integrators/runs/case_integrator.hpp"
 #include "integrators/runs/compare.hpp"
@@ -191,26 +192,27 @@ void check_output_folder(const std::string& dir) {
 
 void prepare_result_folder(const std::string& dir, bool overwrite) {
   check_output_folder(dir);
-  static const char* outputs[] = {"run.json",    "run.json.tmp", "history.csv",  "fields.pvd", "fields.pvd.tmp",
-                                  "checkpoint.cbor", "checkpoint.cbor.tmp", "run.json.reserve", "static.csv", "summary.csv",
-                                  "summary.md", "energy.png",  "momentum.png", "monitors.png", "work_precision.png",
-                                  "modes.csv", "mode_shapes.csv", "modes.pvd"};
+  // The folder is this command's until it exits (lib/result_folder.hpp, docs/guide/result-folders.md): taken
+  // before anything is looked at or removed, so that a second command cannot write or delete under it.
+  hold_result_folder(dir, overwrite ? StaleLock::take_over : StaleLock::refuse, &std::cerr);
+  static const std::vector<std::string> outputs = {
+      "run.json",     "run.json.tmp",   "history.csv",  "fields.pvd",         "fields.pvd.tmp", "checkpoint.cbor",
+      "checkpoint.cbor.tmp", "run.json.reserve", "static.csv", "summary.csv", "summary.md", "energy.png",
+      "momentum.png", "monitors.png",   "work_precision.png", "modes.csv", "mode_shapes.csv", "modes.pvd"};
   std::error_code ec;
   const fs::path d(dir);
   if (!fs::is_directory(d, ec)) return;
   std::vector<fs::path> found;
-  for (const char* f : outputs)
-    if (fs::exists(d / f, ec)) found.push_back(d / f);
+  for (const auto& f : outputs)
+    if (fs::exists(fs::symlink_status(d / f, ec))) found.push_back(d / f);
   const bool fields = fs::is_directory(d / "fields", ec) && !fs::is_empty(d / "fields", ec);
   if (found.empty() && !fields) return;
   if (!overwrite)
     throw std::invalid_argument("-o " + dir + ": holds results of an earlier run (" +
                                 (found.empty() ? std::string("fields/") : found.front().filename().string()) +
                                 "); add --overwrite to replace them, or choose another folder");
-  for (const auto& p : found) fs::remove(p, ec);
-  if (fs::is_directory(d / "fields", ec))
-    for (const auto& e : fs::directory_iterator(d / "fields", ec))
-      if (e.path().extension() == ".vtu" || e.path().extension() == ".tmp") fs::remove(e.path(), ec);
+  // Only regular files shelldyn wrote (its manifest), never through a symbolic link.
+  remove_recorded_outputs(dir, outputs);
 }
 
 namespace {
@@ -235,7 +237,12 @@ void check_range(const std::string& flag, long long value, long long lo, long lo
                                 std::to_string(hi) + ", e.g. " + example);
 }
 
-void print_error(std::ostream& err, const std::string& prefix, const std::string& what) {
+void print_error(std::ostream& err, const std::string& prefix, const std::string& what_in) {
+  // A bare std::bad_alloc (an allocation the memory estimate did not foresee) says what it means.
+  const std::string what = what_in == "std::bad_alloc"
+                               ? "out of memory (" + memory_text(static_cast<double>(available_memory_bytes())) +
+                                     " available); use a coarser mesh or fewer runs at a time (--jobs)"
+                               : what_in;
   std::istringstream in(what);
   std::string line;
   bool first = true;

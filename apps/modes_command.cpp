@@ -10,6 +10,7 @@
 #include "lib/state_output.hpp"
 #include "lib/vtu_writer.hpp"
 
+#include <cstdlib>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -195,9 +196,26 @@ void add_modes_command(CLI::App& app, std::function<int()>& action, const std::s
   CLI::App* sub = app.add_subcommand(
       "modes", "Natural frequencies and mode shapes (K phi = omega^2 M phi, shift-invert Lanczos); write modes.csv, mode_shapes.csv, modes.pvd, run.json");
   sub->add_option("case", o->case_path, "Case file (YAML), e.g. apps/cases/plate-modes-ss-thin.yaml")->required();
-  sub->add_option("-n,--modes", o->num_modes, "Number of modes, rigid-body modes included (default 10)")->check(CLI::PositiveNumber);
+  // Own checks: CLI11's ranges print their bound 1.79769e+308 in full (a 309-digit number).
+  sub->add_option("-n,--modes", o->num_modes, "Number of modes, rigid-body modes included (default 10)")
+      ->check(CLI::Validator(
+          [](std::string& v) -> std::string {
+            char* end = nullptr;
+            const long long n = std::strtoll(v.c_str(), &end, 10);
+            return (end && *end == '\0' && !v.empty() && n >= 1 && n <= 100000) ? std::string()
+                                                                                 : "must be a whole number in 1..100000, e.g. -n 10";
+          },
+          "INT in 1..100000"));
   sub->add_option("--shift", o->shift_hz, "Find the modes nearest this frequency [Hz] (default 0: the lowest modes)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(CLI::Validator(
+          [](std::string& v) -> std::string {
+            char* end = nullptr;
+            const double x = std::strtod(v.c_str(), &end);
+            return (end && *end == '\0' && !v.empty() && std::isfinite(x) && x >= 0.0 && x <= 1e15)
+                       ? std::string()
+                       : "must be a frequency in Hz, >= 0 and at most 1e15, e.g. --shift 50";
+          },
+          "HZ >= 0"));
   sub->add_option("--state", o->state,
                   "Linearise about: initial (default) | static (the case solved statically to t_end; K includes the "
                   "geometric and load stiffness) | static:LAMBDA (to load factor LAMBDA) | FILE (a saved state: a "

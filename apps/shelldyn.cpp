@@ -31,6 +31,7 @@
 #include "integrators/sundials/sundials_info.hpp"
 #include "lib/case_file.hpp"
 #include "lib/discretization.hpp"
+#include "lib/result_folder.hpp"
 #include "lib/run_info.hpp"
 #include "lib/state_output.hpp"
 #include "lib/vtu_writer.hpp"
@@ -259,6 +260,8 @@ struct RunCommandOptions {
   int vtu_every = -1, threads = 0;
   long long max_steps = 0;
   bool quiet = false, overwrite = false, plots = false;
+  bool allow_changed_case = false, allow_other_version = false;  // resume (integrators/checkpoint/checkpoint.hpp)
+  std::string max_memory;                                         // --max-memory (lib/result_folder.hpp)
   CLI::App* cli = nullptr;  // to ask which flags were given
   bool given(const char* flag) const {
     const CLI::Option* opt = cli ? cli->get_option_no_throw(flag) : nullptr;
@@ -275,6 +278,7 @@ void check_run_flags(const RunCommandOptions& o) {
   if (o.given("--threads")) app::check_range("--threads", o.threads, 0, 1024, "--threads 2");
   if (o.given("--max-steps")) app::check_range("--max-steps", o.max_steps, 0, 10000000000LL, "--max-steps 100000");
   if (o.given("--max-wall")) app::check_non_negative("--max-wall", o.max_wall, "--max-wall 3600");
+  if (o.given("--max-memory")) set_memory_limit(parse_memory_size(o.max_memory));  // lib/result_folder.hpp
 }
 
 std::pair<std::string, std::string> split_setting(const std::string& kv) {
@@ -361,6 +365,7 @@ void add_run_command(CLI::App& app, Action& action, const std::string& command) 
   sub->add_option("--max-steps", o->max_steps, "Stop (resumable, exit 4) at the first output time after N steps (default 0: no limit)");
   sub->add_option("--max-wall", o->max_wall, "Stop (resumable, exit 4) after S seconds of wall time (default 0: no limit)");
   sub->add_flag("--overwrite", o->overwrite, "Replace the results of an earlier run in the result folder");
+  sub->add_option("--max-memory", o->max_memory, "Refuse models whose estimated memory exceeds this (e.g. 4G; default: the available memory)");
   o->cli = sub;
   sub->callback([o, &action] { action = [o] { return run_run(*o); }; });
 }
@@ -369,10 +374,10 @@ void add_run_command(CLI::App& app, Action& action, const std::string& command) 
 // `shelldyn resume DIR`: continues a run stopped by a signal, --max-wall/--max-steps or a kill from
 // DIR/checkpoint.cbor (integrators/runs/run_driver.hpp). The case, options and overrides come from the
 // checkpoint; only the limits, the thread count and the progress output can be changed.
-int run_resume(const RunCommandOptions& o) {
-  check_run_flags(o);
-  const std::string dir = o.case_path;
-  const Checkpoint c = read_checkpoint((fs::path(dir) / checkpoint_file_name()).string());
+int run_resume_locked(const RunCommandOptions& o, const std::string& dir) {
+  const std::string ckpt = (fs::path(dir) / checkpoint_file_name()).string();
+  const Checkpoint c = read_checkpoint(ckpt);
+  check_checkpoint_origin(c, ckpt, o.allow_changed_case, o.allow_other_version, &std::cerr);
   load_checkpoint_plugins(c);  // the run's plugins, unless given again with --plugin
   // A run killed with SIGKILL leaves its disk reserve (lib/run_info.hpp DiskReserve) behind, and possibly the
   // temporary of an output it was rewriting (run.json, fields.pvd and checkpoint.cbor are written whole to
@@ -399,6 +404,22 @@ int run_resume(const RunCommandOptions& o) {
   return 0;
 }
 
+// The folder is locked first (lib/result_folder.hpp): a resume never runs beside the run it continues. A
+// failure keeps the folder's earlier status in run.json and records why ("resume_failed").
+int run_resume(const RunCommandOptions& o) {
+  check_run_flags(o);
+  const std::string dir = o.case_path;
+  const std::string previous = begin_resume(dir);
+  try {
+    return run_resume_locked(o, dir);
+  } catch (const RunStopped&) {
+    throw;
+  } catch (const std::exception& e) {
+    if (fs::exists(fs::path(dir) / checkpoint_file_name())) record_failed_resume(dir, previous, one_line(e.what()));
+    throw;
+  }
+}
+
 void add_resume_command(CLI::App& app, Action& action, const std::string& command) {
   auto o = std::make_shared<RunCommandOptions>();
   o->command = command;
@@ -409,6 +430,12 @@ void add_resume_command(CLI::App& app, Action& action, const std::string& comman
   sub->add_option("--threads", o->threads, "OpenMP threads for element loops (default: all cores)");
   sub->add_flag("-q,--quiet", o->quiet, "No progress lines");
   add_plugin_option(sub, o->plugins);
+  sub->add_flag("--allow-changed-case", o->allow_changed_case,
+                "Continue although the case file was edited since the run started (the run goes on with the case text "
+                "the checkpoint keeps)");
+  sub->add_flag("--allow-other-version", o->allow_other_version,
+                "Continue a checkpoint written by another shelldyn version (not bitwise the uninterrupted run)");
+  sub->add_option("--max-memory", o->max_memory, "Refuse models whose estimated memory exceeds this (e.g. 4G; default: the available memory)");
   o->cli = sub;
   sub->callback([o, &action] { action = [o] { return run_resume(*o); }; });
 }

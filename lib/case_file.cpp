@@ -1,6 +1,7 @@
 // Case-file parser (see lib/case_file.hpp for the schema). Every error goes through Parser::fail so
 // that messages share the form "FILE:LINE: key.path: reason (how to fix)".
 #include "lib/case_file.hpp"
+#include "lib/result_folder.hpp"
 
 #include "lib/history_writer.hpp"
 
@@ -9,6 +10,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -173,14 +175,19 @@ MeshSpec parse_mesh(const Parser& p, const YAML::Node& n, const std::string& bas
     p.fail(n, "mesh", has_gen ? "give either 'generator' or 'file', not both (remove one)"
                               : "missing 'generator' or 'file' (add one of them)");
   if (has_file) {
-    p.check_keys(n, "mesh", {"file"}, {"file"});
+    p.check_keys(n, "mesh", {"file", "coincident_nodes"}, {"file"});
     const std::string file = p.string(n["file"], "mesh.file");
     fs::path path(file);
     if (path.is_relative()) path = fs::path(base_dir) / path;
     std::error_code ec;
+    if (fs::exists(path, ec) && !fs::is_regular_file(path, ec))
+      p.fail(n["file"], "mesh.file", "'" + path.string() + "' is not a regular file (a FIFO, device or folder); give the mesh file itself");
     if (!fs::is_regular_file(path, ec))
       p.fail(n["file"], "mesh.file", "cannot find '" + path.string() + "' (paths are relative to the case file)");
-    return MeshFileSpec{fs::absolute(path).lexically_normal().string()};
+    MeshFileSpec m{fs::absolute(path).lexically_normal().string()};
+    if (n["coincident_nodes"].IsDefined())
+      m.coincident_nodes_error = p.choice(n["coincident_nodes"], "mesh.coincident_nodes", {"warn", "error"}) == 1;
+    return m;
   }
   const YAML::Node gen = n["generator"];
   const size_t kind = p.choice(gen, "mesh.generator", {"rectangle", "cell_union", "cylindrical_panel", "hemisphere",
@@ -736,6 +743,17 @@ long long TimeSpec::num_steps() const {
 
 CaseSpec load_case_from_string(const std::string& text, const std::string& source, const std::string& base_dir) {
   const Parser p(source);
+  // Control characters (a NUL byte, binary data): yaml-cpp would report them as, e.g., "unknown escape character".
+  for (size_t k = 0, line = 1; k < text.size(); ++k) {
+    const unsigned char c = static_cast<unsigned char>(text[k]);
+    if (c == '\n') ++line;
+    if (c < 0x20 && c != '\n' && c != '\r' && c != '\t') {
+      char code[8];
+      std::snprintf(code, sizeof code, "0x%02x", c);
+      throw std::runtime_error(source + ":" + std::to_string(line) + ": " + (c == 0 ? std::string("a NUL byte") : "control character " + std::string(code)) +
+                               " at byte " + std::to_string(k + 1) + "; a case file is text (is this a binary or damaged file?)");
+    }
+  }
   YAML::Node root;
   try {
     root = YAML::Load(text);
@@ -759,6 +777,7 @@ CaseSpec load_case_from_string(const std::string& text, const std::string& sourc
 }
 
 CaseSpec load_case(const std::string& path) {
+  require_regular_file(path, "case file");  // a FIFO would block the open forever (lib/result_folder.hpp)
   std::ifstream in(path, std::ios::binary);
   if (!in) throw std::runtime_error(path + ": cannot open the case file (check the path)");
   std::ostringstream text;

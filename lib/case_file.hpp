@@ -92,6 +92,8 @@ struct SlitAnnulusMeshSpec {
 };
 struct MeshFileSpec {
   std::string path;  // absolute (resolved against the case file's folder)
+  // mesh.coincident_nodes: warn (default) | error — distinct nodes at one position (lib/discretization.cpp).
+  bool coincident_nodes_error = false;
 };
 using MeshSpec = std::variant<RectangleMeshSpec, CellUnionMeshSpec, CylindricalPanelMeshSpec, HemisphereMeshSpec,
                               MeshFileSpec, CylinderPatchMeshSpec, ClosedCylinderMeshSpec, SlitAnnulusMeshSpec>;

@@ -1,4 +1,5 @@
 #include "lib/discretization.hpp"
+#include "lib/result_folder.hpp"
 
 #include "lib/surface_loads.hpp"
 
@@ -10,6 +11,8 @@
 #include <algorithm>
 #include <cctype>
 #include <fstream>
+#include <iostream>
+#include <mutex>
 #include <array>
 #include <functional>
 #include <cmath>
@@ -66,6 +69,11 @@ const std::vector<int>& find_set(const Mesh& mesh, const std::string& name, cons
 std::map<int, Eigen::Matrix<double, 6, 1>> read_node_csv(const std::string& path, int num_nodes, const std::string& where,
                                                          const std::string& what, const std::string& cols3,
                                                          const std::string& cols6, bool* with6) {
+  try {
+    require_regular_file(path, what);  // a FIFO would block the open forever (lib/result_folder.hpp)
+  } catch (const std::exception& e) {
+    fail(where, e.what());
+  }
   std::ifstream in(path);
   if (!in) fail(where, "cannot open the " + what + " '" + path + "' (check the path; relative to the case file)");
   std::string line;
@@ -126,6 +134,11 @@ std::map<int, Eigen::Matrix<double, 6, 1>> read_velocity_field(const std::string
 // read_velocity_field. Every node of the mesh must be in the file for that mode.
 std::map<int, Eigen::Matrix<double, 6, 1>> read_mode_field(const std::string& path, int index, double amplitude,
                                                            int num_nodes, const std::string& where) {
+  try {
+    require_regular_file(path, "mode-shape file");
+  } catch (const std::exception& e) {
+    fail(where + ".mode", e.what());
+  }
   std::ifstream in(path);
   if (!in)
     fail(where + ".mode", "cannot open the mode-shape file '" + path +
@@ -329,11 +342,37 @@ Mesh build_mesh(const CaseSpec& spec) {
   }
 }
 
+// Distinct nodes at one position (within 1e-9 of the mesh size), e.g. two meshed parts that the mesher did not
+// merge: they share no DOF, so the parts are not connected. Pairs (a, b), a < b, sorted; found by sorting along x.
+std::vector<std::pair<int, int>> coincident_node_pairs(const Mesh& mesh, double size) {
+  const double tol = 1e-9 * std::max(size, 1e-300);
+  std::vector<int> order(mesh.X.size());
+  for (size_t i = 0; i < order.size(); ++i) order[i] = static_cast<int>(i);
+  std::sort(order.begin(), order.end(), [&](int a, int b) { return mesh.X[static_cast<size_t>(a)].x() < mesh.X[static_cast<size_t>(b)].x(); });
+  std::vector<std::pair<int, int>> pairs;
+  for (size_t i = 0; i < order.size(); ++i)
+    for (size_t j = i + 1; j < order.size(); ++j) {
+      const Vec3& a = mesh.X[static_cast<size_t>(order[i])];
+      const Vec3& b = mesh.X[static_cast<size_t>(order[j])];
+      if (b.x() - a.x() > tol) break;
+      if ((a - b).norm() <= tol) pairs.emplace_back(std::min(order[i], order[j]), std::max(order[i], order[j]));
+    }
+  std::sort(pairs.begin(), pairs.end());
+  return pairs;
+}
+
 Discretization build_discretization(const CaseSpec& spec) {
   Discretization d;
   d.mesh = build_mesh(spec);
   Mesh& mesh = d.mesh;
   const int n = mesh.num_nodes();
+  // Before the matrices are allocated: a model that cannot fit is refused with the estimate (lib/result_folder.hpp).
+  try {
+    check_memory_estimate(n, mesh.num_elements(), "",
+                          "use a coarser mesh, or a machine with more memory (--max-memory sets the limit)");
+  } catch (const std::exception& e) {
+    fail(spec.mesh_where, e.what());
+  }
   try {
     orient_consistently(mesh);
     d.normals = initial_normals(mesh);
@@ -349,6 +388,28 @@ Discretization build_discretization(const CaseSpec& spec) {
   for (const Vec3& x : mesh.X) lo = lo.cwiseMin(x), hi = hi.cwiseMax(x);
   d.mesh_size = (hi - lo).norm();
   d.total_mass = spec.material.rho * spec.material.thickness * d.surface_area;
+
+  // Coincident unmerged nodes (docs/guide/result-folders.md "Inputs"): a warning naming them, an error with
+  // mesh.coincident_nodes: error.
+  if (const auto pairs = coincident_node_pairs(mesh, d.mesh_size); !pairs.empty()) {
+    std::string list;
+    for (size_t k = 0; k < pairs.size() && k < 3; ++k)
+      list += (k ? ", " : "") + std::to_string(pairs[k].first) + " & " + std::to_string(pairs[k].second);
+    if (pairs.size() > 3) list += ", ...";
+    const Vec3& x = mesh.X[static_cast<size_t>(pairs.front().first)];
+    std::ostringstream at;
+    at << "(" << x.x() << ", " << x.y() << ", " << x.z() << ")";
+    // Node numbers 0-based, as the point ids of the VTU output (Gmsh files: in ascending node-tag order).
+    const std::string msg = std::to_string(pairs.size()) + " coincident node pairs not merged (" + list + ", first at " + at.str() +
+                            "); merge them (Gmsh: Coherence Mesh)";
+    const auto* file = std::get_if<MeshFileSpec>(&spec.mesh);
+    if (file && file->coincident_nodes_error) fail(spec.mesh_where, msg);
+    static std::mutex m;
+    static std::set<std::string> warned;  // once per case and process (check builds the model twice)
+    std::lock_guard<std::mutex> g(m);
+    if (warned.insert(spec.mesh_where + msg).second)
+      std::cerr << "warning: " << spec.mesh_where << ": " << msg << ": the parts are not connected (mesh.coincident_nodes: error refuses such meshes)" << std::endl;
+  }
 
   resolve_case_sets(spec, mesh, d.mesh_size);
 

@@ -1,5 +1,6 @@
 // Gmsh MSH 4.1 ASCII reader (format reference: Gmsh manual, "MSH file format", version 4.1).
 #include "lib/gmsh_reader.hpp"
+#include "lib/result_folder.hpp"
 
 #include <algorithm>
 #include <cctype>
@@ -166,6 +167,7 @@ struct ElementBlock {
 }  // namespace
 
 Mesh read_gmsh(const std::string& path) {
+  require_regular_file(path, "mesh file");  // a FIFO would block the open forever (lib/result_folder.hpp)
   std::ifstream in(path);
   if (!in) throw std::runtime_error(path + ": cannot open the file for reading (check the path)");
   return read_gmsh(in, path);

@@ -1,4 +1,7 @@
 #include "lib/history_writer.hpp"
+#include "lib/result_folder.hpp"
+
+#include <fcntl.h>
 
 #include <unistd.h>
 
@@ -28,11 +31,12 @@ HistoryWriter::HistoryWriter(const std::string& path, std::vector<std::string> e
   columns_.insert(columns_.end(), extra_columns.begin(), extra_columns.end());
   columns_.insert(columns_.end(), monitor_columns.begin(), monitor_columns.end());
   check_columns();
-  file_ = std::fopen(path.c_str(), "w");
-  if (!file_) throw std::runtime_error(path + ": cannot create history file: " + std::strerror(errno));
-  for (size_t k = 0; k < columns_.size(); ++k) std::fprintf(file_, "%s%s", k ? "," : "", columns_[k].c_str());
-  std::fputc('\n', file_);
-  if (std::fflush(file_) != 0) throw std::runtime_error(path_ + ": cannot write history.csv: " + write_error_reason(errno));
+  record_output(path);  // the result folder's manifest (lib/result_folder.hpp)
+  fd_ = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_APPEND | O_CLOEXEC, 0644);
+  if (fd_ < 0) throw std::runtime_error(path + ": cannot create history file: " + std::strerror(errno));
+  std::string header;
+  for (size_t k = 0; k < columns_.size(); ++k) header += (k ? "," : "") + columns_[k];
+  write_whole(header + "\n");
 }
 
 HistoryWriter::HistoryWriter(const std::string& path, std::vector<std::string> extra_columns,
@@ -57,11 +61,34 @@ HistoryWriter::HistoryWriter(const std::string& path, std::vector<std::string> e
                              std::to_string(keep_bytes) + " bytes); cannot resume");
   if (truncate(path.c_str(), static_cast<off_t>(keep_bytes)) != 0)
     throw std::runtime_error(path + ": cannot cut the rows after the checkpoint: " + std::strerror(errno));
-  file_ = std::fopen(path.c_str(), "a");
-  if (!file_) throw std::runtime_error(path + ": cannot append to the history file: " + std::strerror(errno));
+  fd_ = ::open(path.c_str(), O_WRONLY | O_APPEND | O_CLOEXEC);
+  if (fd_ < 0) throw std::runtime_error(path + ": cannot append to the history file: " + std::strerror(errno));
+  bytes_ = keep_bytes;
 }
 
-long long HistoryWriter::bytes() const { return file_ ? static_cast<long long>(std::ftell(file_)) : 0; }
+long long HistoryWriter::bytes() const { return fd_ >= 0 ? bytes_ : 0; }
+
+void HistoryWriter::sync() {
+  if (fd_ >= 0 && ::fsync(fd_) != 0) throw std::runtime_error(path_ + ": cannot write history.csv: " + write_error_reason(errno));
+}
+
+// One write(2) of the whole text (a short write, e.g. on a full disk, is cut back: no half row stays).
+void HistoryWriter::write_whole(const std::string& text) {
+  if (fd_ < 0) throw std::runtime_error(path_ + ": closed after an earlier write error");
+  ssize_t n = ::write(fd_, text.data(), text.size());
+  while (n < 0 && errno == EINTR) n = ::write(fd_, text.data(), text.size());
+  if (n == static_cast<ssize_t>(text.size())) {
+    bytes_ += n;
+    return;
+  }
+  const int err = n < 0 ? errno : ENOSPC;
+  if (n > 0 && ftruncate(fd_, static_cast<off_t>(bytes_)) != 0) {
+    // if even this fails, the write error below is still the one to report
+  }
+  ::close(fd_);
+  fd_ = -1;
+  throw std::runtime_error(path_ + ": cannot write history.csv: " + write_error_reason(err));
+}
 
 void HistoryWriter::check_columns() {
   std::set<std::string> seen;
@@ -75,7 +102,7 @@ void HistoryWriter::check_columns() {
 }
 
 HistoryWriter::~HistoryWriter() {
-  if (file_) std::fclose(file_);
+  if (fd_ >= 0) ::close(fd_);
 }
 
 void HistoryWriter::write(const HistoryRow& r) {
@@ -83,28 +110,21 @@ void HistoryWriter::write(const HistoryRow& r) {
     throw std::invalid_argument("history.csv: row has " + std::to_string(r.extra.size()) + " extra and " +
                                 std::to_string(r.monitors.size()) + " monitor values, header expects " +
                                 std::to_string(num_extra_) + " and " + std::to_string(num_monitors_));
-  if (!file_) throw std::runtime_error(path_ + ": closed after an earlier write error");
-  const long row_start = std::ftell(file_);
-  std::fprintf(file_, "%lld", r.step);
-  const double reals[] = {r.t, r.dt, r.kinetic, r.strain, r.external_work, r.total, r.rel_drift,
-                          r.L.x(), r.L.y(), r.L.z(), r.J.x(), r.J.y(), r.J.z()};
-  for (double v : reals) std::fprintf(file_, ",%.17g", v);
-  std::fprintf(file_, ",%lld,%lld,%.17g", r.nonlinear_iters, r.linear_setups, r.wall_s);
-  for (double v : r.extra) std::fprintf(file_, ",%.17g", v);
-  for (double v : r.monitors) std::fprintf(file_, ",%.17g", v);
-  std::fputc('\n', file_);
-  if (std::fflush(file_) != 0 || std::ferror(file_)) {
-    const int err = errno;
-    // No half row: close, then cut the file back to the rows written whole (close first, so that
-    // nothing left in the stdio buffer lands after the cut).
-    std::fclose(file_);
-    file_ = nullptr;
-    if (row_start >= 0) {
-      const int rc = truncate(path_.c_str(), static_cast<off_t>(row_start));
-      (void)rc;  // if even this fails, the write error below is still the one to report
-    }
-    throw std::runtime_error(path_ + ": cannot write history.csv: " + write_error_reason(err));
-  }
+  std::string line = std::to_string(r.step);
+  char b[40];
+  auto add = [&](double v) {
+    std::snprintf(b, sizeof b, ",%.17g", v);
+    line += b;
+  };
+  for (double v : {r.t, r.dt, r.kinetic, r.strain, r.external_work, r.total, r.rel_drift, r.L.x(), r.L.y(), r.L.z(), r.J.x(),
+                   r.J.y(), r.J.z()})
+    add(v);
+  line += "," + std::to_string(r.nonlinear_iters) + "," + std::to_string(r.linear_setups);
+  add(r.wall_s);
+  for (double v : r.extra) add(v);
+  for (double v : r.monitors) add(v);
+  line += '\n';
+  write_whole(line);
 }
 
 }  // namespace shelldyn

@@ -2,8 +2,10 @@
 //
 // Columns, in order: the standard columns of history_standard_columns(), then the caller's extra
 // columns (integrator-specific counters), then one column per monitor. Values are written with
-// %.17g (round-trip exact); integer counters as integers. Each row is flushed, so a crashed or
-// interrupted run leaves a readable file.
+// %.17g (round-trip exact); integer counters as integers. Each row is formatted whole and reaches the
+// file with one write(2) on an O_APPEND descriptor (docs/guide/result-folders.md "history.csv"): a killed
+// run leaves complete rows only, and nothing is buffered in the process. sync() (fsync) is called by the
+// run driver before each checkpoint, so that a checkpoint never counts rows a power loss could take back.
 #pragma once
 
 #include <Eigen/Core>
@@ -53,11 +55,15 @@ class HistoryWriter {
   const std::string& path() const { return path_; }
   // Bytes written so far (header included): the resume position of a checkpoint.
   long long bytes() const;
+  // fsync(2): the rows written so far are on the disk. Throws std::runtime_error on failure.
+  void sync();
 
  private:
   void check_columns();
+  void write_whole(const std::string& text);
   std::string path_;
-  std::FILE* file_ = nullptr;
+  int fd_ = -1;
+  long long bytes_ = 0;
   size_t num_extra_ = 0, num_monitors_ = 0;
   std::vector<std::string> columns_;
 };

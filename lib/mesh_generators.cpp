@@ -7,6 +7,7 @@
 // The parameter direction I (-> xi) and J (-> eta) are chosen so that X,xi x X,eta points to the
 // documented normal side, i.e. corners run counter-clockwise seen from there (docs/theory.md §2.4).
 #include "lib/mesh_generators.hpp"
+#include "lib/result_folder.hpp"
 
 #include <algorithm>
 #include <climits>
@@ -60,6 +61,12 @@ void require_int_nodes(const std::string& gen, std::int64_t nodes) {
     bad_parameter(gen, "the requested mesh would have " + std::to_string(nodes) +
                            " nodes, more than the supported " + std::to_string(INT_MAX / 8) +
                            "; reduce the element counts");
+  // Before the node arrays are allocated (lib/result_folder.hpp): a grid of quad9 elements has ~nodes/4 elements.
+  try {
+    check_memory_estimate(nodes, nodes / 4, "", "reduce the element counts (or raise --max-memory)");
+  } catch (const std::runtime_error& e) {
+    bad_parameter(gen, e.what());
+  }
 }
 
 // (1 - t) a + t b: returns a at t = 0 and b at t = 1 exactly (boundary coordinates are exact).

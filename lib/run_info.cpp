@@ -1,6 +1,7 @@
 #include "lib/run_info.hpp"
 
 #include "lib/linear_solver.hpp"
+#include "lib/result_folder.hpp"
 
 #include <Eigen/Core>
 #include <nlohmann/json.hpp>
@@ -233,6 +234,7 @@ void write_text_atomically(const std::string& path, const std::string& text, con
                                                : std::string(std::strerror(err));
     throw std::runtime_error(path + ": cannot " + step + " " + what + ": " + reason);
   };
+  record_output(path);  // the result folder's manifest (lib/result_folder.hpp): --overwrite removes it
   std::FILE* f = std::fopen(tmp.c_str(), "wb");
   if (!f) fail("create", errno);
   errno = 0;

@@ -1,4 +1,5 @@
 #include "lib/vtu_reader.hpp"
+#include "lib/result_folder.hpp"
 
 #include <algorithm>
 #include <cctype>
@@ -22,6 +23,7 @@ namespace fs = std::filesystem;
 }
 
 std::string read_all(const std::string& path, const char* what) {
+  require_regular_file(path, what);  // a FIFO would block the open forever (lib/result_folder.hpp)
   std::ifstream in(path, std::ios::binary);
   if (!in) fail(path, std::string("cannot open the ") + what + ": " + std::strerror(errno) + " (check the path)");
   std::ostringstream os;
@@ -190,6 +192,7 @@ bool vtu_time_from_pvd(const std::string& vtu_path, double* time) {
   const fs::path run_dir = vtu.parent_path().parent_path();
   const fs::path pvd = run_dir / "fields.pvd";
   if (!fs::exists(pvd, ec)) return false;
+  require_regular_file(pvd, "fields.pvd");
   std::ifstream in(pvd);
   std::string line;
   while (std::getline(in, line)) {

@@ -1,4 +1,5 @@
 #include "lib/vtu_writer.hpp"
+#include "lib/result_folder.hpp"
 
 #include <cerrno>
 #include <cstdio>
@@ -31,7 +32,8 @@ std::string xml_escape(const std::string& s) {
 
 class File {
  public:
-  explicit File(const std::string& path) : path_(path), f_(std::fopen(path.c_str(), "w")) {
+  // Recorded in the result folder's manifest first (lib/result_folder.hpp): --overwrite removes it.
+  explicit File(const std::string& path) : path_(path), f_((record_output(path), std::fopen(path.c_str(), "w"))) {
     if (!f_) throw std::runtime_error(path + ": cannot create file: " + std::strerror(errno));
   }
   ~File() {  // not closed: an exception interrupted the write; leave no half-written file behind

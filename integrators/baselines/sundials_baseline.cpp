@@ -23,6 +23,7 @@ SundialsBaseline::SundialsBaseline(std::string name, IntegratorSettings& s) : na
   max_step_ = s.get("max_step", 0.0);
   init_step_ = s.get("init_step", 0.0);
   max_steps_ = s.get("max_steps", 1e8);
+  dt_min_ = s.get("dt_min", 0.0);
   chart_overshoot_ = s.get("chart_overshoot", 0.05);
   mass_solver_ = s.get("mass_solver", "eigen-ldlt");
   mass_reuse_ = s.get("mass_reuse", true);
@@ -36,6 +37,8 @@ SundialsBaseline::SundialsBaseline(std::string name, IntegratorSettings& s) : na
   if (!(max_step_ >= 0.0) || !(init_step_ >= 0.0))
     throw std::invalid_argument(name_ + ": max_step and init_step must be >= 0 (0 = the solver's choice)");
   if (!(max_steps_ >= 1.0)) throw std::invalid_argument(name_ + ": max_steps must be >= 1");
+  if (!(dt_min_ >= 0.0) || !std::isfinite(dt_min_))
+    throw std::invalid_argument(name_ + ": dt_min must be >= 0 (0 = 1e-7 of the output interval), got " + num(dt_min_));
   if (!(progress_every_ >= 0.0)) throw std::invalid_argument(name_ + ": progress_every must be >= 0 (seconds; 0 = off)");
   if (mass_solver_ != "eigen-ldlt" && mass_solver_ != "cholmod")
     throw std::invalid_argument(name_ + ": mass_solver '" + mass_solver_ +
@@ -144,6 +147,11 @@ StepReport SundialsBaseline::advance(SemiDiscreteSystem& system, State& state, d
   }
   const double t_tol = 1e-12 * std::max(1.0, std::abs(t_out));
   if (t_out - t_ > t_tol) set_stop_time(t_out);
+  // Step-count guard (header, dt_min): an interval of length T needs at most T/dt_min steps; an integrator that
+  // takes more (or 1000 steps in a row below dt_min) is crawling, e.g. under a load far too large for the model.
+  const double t_start = t_, dt_min = dt_min_ > 0.0 ? dt_min_ : 1e-7 * (t_out - t_);
+  const double guard = std::ceil((t_out - t_) / std::max(dt_min, 1e-300)) + 1000.0;
+  double taken = 0.0, below = 0.0;
   while (t_out - t_ > t_tol) {
     errors_.clear();
     sundials_message_.clear();
@@ -163,6 +171,20 @@ StepReport SundialsBaseline::advance(SemiDiscreteSystem& system, State& state, d
       std::ostringstream os;
       os << name_ << ": stopped on request at t = " << t_ << " (state kept at t = " << state.t << ")";
       throw RunInterrupted(os.str());
+    }
+    taken += 1.0;
+    below = last_step() < dt_min ? below + 1.0 : 0.0;
+    if (taken > guard || below >= 1000.0) {
+      add_counters(rep);
+      std::ostringstream os;
+      os.precision(3);
+      os << name_ << ": crawling at t = " << t_ << " (";
+      if (below >= 1000.0)
+        os << "1000 steps in a row below dt_min = " << dt_min << ", the last " << last_step();
+      else
+        os << taken << " steps since t = " << t_start << ", more than the interval / dt_min = " << dt_min;
+      os << "); raise rtol, lower dt_min or use a fixed-step integrator";
+      throw StepFailure(os.str());
     }
     const StepOutcome what = outcome(flag);
     if (what == StepOutcome::reached) break;

@@ -19,7 +19,9 @@
 // atol_director_rate, atol_work, length_scale, time_scale.
 //
 // Common settings: rtol [1e-6], atol [0 = rtol/1000], length_scale [0 = auto], time_scale [0 = auto],
-// max_step [0 = none], init_step [0 = solver's choice], max_steps [1e8], chart_overshoot [0.05],
+// max_step [0 = none], init_step [0 = solver's choice], max_steps [1e8], dt_min [0 = 1e-7 of the output interval:
+// an output interval of length T may take at most T/dt_min + 1000 steps, and at most 1000 steps in a row below
+// dt_min; beyond, the run fails with "crawling" instead of running for days], chart_overshoot [0.05],
 // mass_solver [eigen-ldlt], mass_reuse [true] (FirstOrderSystem), progress_every [10 s wall; 0 = off].
 #pragma once
 
@@ -84,7 +86,7 @@ class SundialsBaseline : public Integrator {
   // settings
   std::string name_, mass_solver_;
   double rtol_ = 1e-6, atol_ = 0.0, length_scale_ = 0.0, time_scale_ = 0.0, max_step_ = 0.0, init_step_ = 0.0,
-         max_steps_ = 1e8, chart_overshoot_ = 0.05, progress_every_ = 10.0;
+         max_steps_ = 1e8, dt_min_ = 0.0, chart_overshoot_ = 0.05, progress_every_ = 10.0;
   bool mass_reuse_ = true;
   std::vector<std::pair<std::string, std::string>> resolved_, tolerance_report_;
 

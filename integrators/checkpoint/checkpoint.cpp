@@ -1,5 +1,6 @@
 #include "integrators/checkpoint/checkpoint.hpp"
 
+#include "lib/result_folder.hpp"
 #include "lib/run_info.hpp"
 
 #include <nlohmann/json.hpp>
@@ -7,6 +8,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <sstream>
@@ -81,6 +83,32 @@ const Eigen::VectorXd& Checkpoint::vector(const std::string& key) const {
   return it->second;
 }
 
+void check_checkpoint_origin(const Checkpoint& c, const std::string& path, bool allow_changed_case,
+                             bool allow_other_version, std::ostream* note) {
+  if (!c.made_by.empty() && c.made_by != shelldyn_version()) {
+    if (!allow_other_version)
+      throw std::runtime_error(path + ": written by shelldyn " + c.made_by + ", this is " + shelldyn_version() +
+                               "; resume with that version, or add --allow-other-version (the continuation may then "
+                               "differ from an uninterrupted run)");
+    if (note) *note << "note: " << path << ": written by shelldyn " << c.made_by << ", continued by " << shelldyn_version() << std::endl;
+  }
+  const auto src = c.texts.find("case_source");
+  const auto text = c.texts.find("case_text");
+  if (src == c.texts.end() || text == c.texts.end() || src->second.empty()) return;
+  std::ifstream in(src->second, std::ios::binary);
+  if (!in) {
+    if (note) *note << "note: " << src->second << " (the case file) is gone; continuing with the case text the checkpoint keeps" << std::endl;
+    return;
+  }
+  const std::string now((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (now == text->second) return;
+  if (!allow_changed_case)
+    throw std::runtime_error(src->second + ": the case file was edited after the run in " +
+                             std::filesystem::path(path).parent_path().string() +
+                             " started; rerun from the start, or add --allow-changed-case to continue the run as it started");
+  if (note) *note << "note: " << src->second << " was edited since the run started; continuing with the case text the checkpoint keeps" << std::endl;
+}
+
 std::string content_hash(const std::string& bytes) {
   std::uint64_t h = 1469598103934665603ULL;
   for (unsigned char c : bytes) {
@@ -119,22 +147,59 @@ void write_checkpoint(const std::string& path, const Checkpoint& c) {
   j["numbers"] = map_of_numbers(c.numbers);
   j["texts"] = c.texts;
   j["vectors"] = map_of_vectors(c.vectors);
-  const std::vector<std::uint8_t> cbor = Json::to_cbor(j);
+  // The integrity wrapper (checkpoint.hpp): the document as a byte string with its checksum.
+  std::vector<std::uint8_t> body = Json::to_cbor(j);
+  const auto ct = c.texts.find("case_text");
+  const std::string made_by = shelldyn_version();
+  const std::string case_hash = content_hash(ct == c.texts.end() ? std::string() : ct->second);
+  const std::string sum = content_hash(made_by + "\n" + case_hash + "\n" + std::string(body.begin(), body.end()));
+  Json w;
+  w["format"] = kFormat;
+  w["version"] = Checkpoint::kVersion;
+  w["shelldyn"] = made_by;
+  w["case_hash"] = case_hash;
+  w["checksum"] = sum;
+  w["body"] = Json::binary(std::move(body));
+  const std::vector<std::uint8_t> cbor = Json::to_cbor(w);
   write_text_atomically(path, std::string(cbor.begin(), cbor.end()), "checkpoint");
 }
 
 Checkpoint read_checkpoint(const std::string& path) {
+  require_regular_file(path, "checkpoint");  // a FIFO would block the open forever
   std::ifstream in(path, std::ios::binary);
-  if (!in) throw std::runtime_error(path + ": no checkpoint here (was the run started with checkpoints on?)");
+  if (!in) {
+    std::error_code ec;
+    if (std::filesystem::exists(path, ec)) throw std::runtime_error(path + ": cannot read the checkpoint (permission denied?)");
+    // Why there is none (the run completed, wrote none, ...): lib/result_folder.hpp.
+    throw std::runtime_error(explain_missing_checkpoint(std::filesystem::path(path).parent_path().string()));
+  }
   const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   try {
-    const Json j = Json::from_cbor(bytes);
-    if (!j.is_object() || j.value("format", "") != kFormat)
+    const Json w = Json::from_cbor(bytes);
+    if (!w.is_object() || w.value("format", "") != kFormat)
       throw std::runtime_error("not a shelldyn checkpoint");
-    if (j.at("version").get<int>() != Checkpoint::kVersion)
-      throw std::runtime_error("checkpoint version " + std::to_string(j.at("version").get<int>()) + ", this shelldyn reads " +
+    const int version = w.at("version").get<int>();
+    if (version != Checkpoint::kVersion && version != 1)
+      throw std::runtime_error("checkpoint version " + std::to_string(version) + ", this shelldyn reads " +
                                std::to_string(Checkpoint::kVersion));
+    Json j;
+    std::string made_by;
+    if (version == 1) {  // written before checksums: read as it is
+      j = w;
+    } else {
+      made_by = w.at("shelldyn").get<std::string>();
+      const std::string case_hash = w.at("case_hash").get<std::string>();
+      const auto& body = w.at("body").get_binary();
+      const std::string sum = content_hash(made_by + "\n" + case_hash + "\n" + std::string(body.begin(), body.end()));
+      if (sum != w.at("checksum").get<std::string>()) throw Json::other_error::create(599, "checksum mismatch", nullptr);
+      j = Json::from_cbor(body);
+      if (!j.is_object()) throw std::runtime_error("not a shelldyn checkpoint");
+      const auto texts = j.at("texts");
+      if (content_hash(texts.value("case_text", std::string())) != case_hash)
+        throw Json::other_error::create(599, "case hash mismatch", nullptr);
+    }
     Checkpoint c;
+    c.made_by = made_by;
     const Json& s = j.at("state");
     const Eigen::VectorXd t = vector_of(s.at("t"), "t");
     if (t.size() != 1) throw std::runtime_error("state.t is not one value");
@@ -161,7 +226,10 @@ Checkpoint read_checkpoint(const std::string& path) {
     c.vectors = vectors_of(j.at("vectors"));
     return c;
   } catch (const nlohmann::json::exception& e) {
-    throw std::runtime_error(path + ": damaged checkpoint; rerun from the start\n" + std::string(e.what()));
+    std::string why = e.what();  // "[json.exception.other_error.599] checksum mismatch" -> "checksum mismatch"
+    if (const auto b = why.find("] "); b != std::string::npos) why = why.substr(b + 2);
+    if (why.size() > 60) why = why.substr(0, 57) + "...";
+    throw std::runtime_error(path + ": damaged checkpoint; rerun from the start (" + why + ")");
   } catch (const std::invalid_argument& e) {
     throw std::runtime_error(path + ": damaged checkpoint; rerun from the start\n" + std::string(e.what()));
   } catch (const std::runtime_error& e) {

@@ -6,6 +6,7 @@
 #include "integrators/sundials/sundials_info.hpp"
 #include "lib/history_writer.hpp"
 #include "lib/reactions.hpp"
+#include "lib/result_folder.hpp"
 #include "lib/run_info.hpp"
 #include "lib/state_output.hpp"
 
@@ -352,6 +353,8 @@ RunSummary run_dynamic(Problem& problem, const RunOptions& o) {
   const std::string run_json_path = o.out_dir + "/run.json";
   const std::string checkpoint_path = o.out_dir + "/" + checkpoint_file_name();
   std::unique_ptr<DiskReserve> reserve;  // room for the final run.json on a disk the outputs fill (lib/run_info.hpp)
+  // One writer per result folder (lib/result_folder.hpp); re-entrant: the CLI commands already hold theirs.
+  const FolderLock folder_lock = files ? FolderLock(o.out_dir, StaleLock::take_over, &std::cerr) : FolderLock();
   if (files) {
     prepare_output_folder(o.out_dir);
     write_run_json(run_json_path, spec, info);
@@ -491,6 +494,7 @@ RunSummary run_dynamic(Problem& problem, const RunOptions& o) {
     }
     c.numbers["max_steps"] = static_cast<double>(o.max_steps);
     c.numbers["max_wall"] = o.max_wall;
+    if (history) history->sync();  // the rows the checkpoint counts are on the disk before it is
     write_checkpoint(checkpoint_path, c);
     info.checkpoint.set("file", checkpoint_file_name());
     info.checkpoint.set("t", state.t);

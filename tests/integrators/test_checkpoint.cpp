@@ -8,6 +8,7 @@
 #include "dynamics_fixtures.hpp"
 
 #include "integrators/checkpoint/checkpoint.hpp"
+#include "lib/run_info.hpp"
 #include "integrators/runs/registry.hpp"
 
 #include <gtest/gtest.h>
@@ -16,6 +17,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <functional>
 #include <limits>
 
@@ -98,6 +100,46 @@ TEST(Checkpoint, DamagedOrMissingFilesAreRejectedWithOneLine) {
   fs::resize_file(path, size / 2);
   EXPECT_THROW(read_checkpoint(path), std::runtime_error);
   EXPECT_THROW(read_checkpoint(path + ".absent"), std::runtime_error);
+}
+
+// Integrity (checkpoint.hpp): every single-bit flip anywhere in a checkpoint is refused as damaged, and a
+// checkpoint records the shelldyn version that wrote it.
+TEST(Checkpoint, EverySingleBitFlipIsRefused) {
+  const std::string path = scratch("flips");
+  Checkpoint c;
+  c.state.t = 0.25;
+  c.state.u = c.state.v = c.state.a = Eigen::VectorXd::LinSpaced(12, -1.0, 1.0);
+  c.integrator = "em-galpha";
+  c.integrator_data.scalars["W_ext"] = 1.5;
+  c.numbers["steps"] = 25;
+  c.texts["case_text"] = "name: x\n";
+  write_checkpoint(path, c);
+  EXPECT_EQ(read_checkpoint(path).made_by, shelldyn_version());
+  std::string bytes;
+  {
+    std::ifstream in(path, std::ios::binary);
+    bytes.assign((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  }
+  ASSERT_GT(bytes.size(), 100u);
+  int refused = 0, accepted = 0;
+  for (size_t bit = 0; bit < 8 * bytes.size(); ++bit) {
+    std::string b = bytes;
+    b[bit / 8] = static_cast<char>(b[bit / 8] ^ (1 << (bit % 8)));
+    {
+      std::ofstream out(path, std::ios::binary | std::ios::trunc);
+      out << b;
+    }
+    try {
+      read_checkpoint(path);
+      ++accepted;
+    } catch (const std::runtime_error& e) {
+      const std::string w = e.what();
+      EXPECT_EQ(w.find('\n'), std::string::npos) << w;  // one line
+      ++refused;
+    }
+  }
+  EXPECT_EQ(accepted, 0) << "of " << 8 * bytes.size() << " single-bit flips";
+  EXPECT_EQ(refused, static_cast<int>(8 * bytes.size()));
 }
 
 class NoCheckpoints final : public Integrator {
