@@ -197,7 +197,17 @@ std::unique_ptr<StudyPlan> plan_study(const StudyOptions& o) {
     co.log = o.report ? o.log : nullptr;
     co.command = o.command;
     for (const auto& r : runs) co.specs.push_back(r.spec);
-    const std::vector<CompareRun> expanded = expand_compare_runs(co);  // labels; bad specs fail here
+    std::vector<CompareRun> expanded;
+    try {
+      expanded = expand_compare_runs(co);  // labels; bad specs fail here
+    } catch (const std::invalid_argument& e) {
+      // compare speaks of its --integrators option; here the runs come from the study file.
+      std::string msg = e.what();
+      const std::string twice = "--integrators: run '";
+      if (msg.rfind(twice, 0) == 0)
+        msg = group + ": run '" + msg.substr(twice.size()) + " (the reference, a sweep value or a full.runs entry repeats another run; list each once)";
+      throw std::invalid_argument((p.source.empty() ? std::string("study ") + p.name : p.source) + ": " + msg);
+    }
     std::vector<std::string> pending;
     for (size_t k = 0; k < runs.size(); ++k) {
       labelled[group].emplace_back(runs[k], expanded[k].label);

@@ -15,7 +15,7 @@ on a one-element soft plate (the case of check_plot_study.py: loads end at 0.1 s
 seconds for all runs), then checks that both made the same runs (labels per group) with the same t_end,
 steps, RHS evaluations, factorizations, nonlinear iterations and history rows (output times). A study file
 that drops, adds or changes one run, one sweep value, the window, an output interval or the full runs' Δt
-fails it.
+fails it. Then `--add-method galpha:rho_inf=0.5` into the same folder makes only that method's 5 runs.
 """
 import csv
 import json
@@ -49,11 +49,12 @@ BASELINE = "ida-bdf:rtol=0.0001:atol=1e-06"
 # interval, Δt sweep, reference, full-duration Δt and output interval: None = the case's).
 PRESETS = {
     "flying-plate": dict(t_end="0.5", output="0.005", dts="4e-3,2e-3,1e-3,5e-4", reference="em-galpha:dt=0.000125",
-                         full_dt=None, full_output=None),
+                         full_dt=None, full_output=None, dt_labels=["0.004", "0.002", "0.001", "0.0005"]),
     "cylindrical-panel": dict(t_end="0.004", output="4e-5", dts="4e-5,2e-5,1e-5,5e-6", reference="em-galpha:dt=1.25e-06",
-                              full_dt=None, full_output=None),
+                              full_dt=None, full_output=None, dt_labels=["4e-05", "2e-05", "1e-05", "5e-06"]),
     "pinched-hemisphere": dict(t_end="0.0025", output="1.25e-4", dts="5e-4,2.5e-4,1.25e-4,6.25e-5",
-                               reference="em-galpha:dt=1.5625e-05", full_dt="1.25e-3", full_output="1.25e-3"),
+                               reference="em-galpha:dt=1.5625e-05", full_dt="1.25e-3", full_output="1.25e-3",
+                               full_dt_label="0.00125", dt_labels=["0.0005", "0.00025", "0.000125", "6.25e-05"]),
 }
 COUNTS = ["t_end", "steps", "rhs_evaluations", "factorizations", "nonlinear_iterations"]
 
@@ -121,6 +122,18 @@ def main():
         if a != b:
             fail(f"{r['group']}/{r['label']}: {a} history rows from the study file, {b} from the old preset")
         checked += 1
+    # A method added to the shipped study (--add-method, any registered integrator) joins its Δt sweep and its
+    # full-duration runs; into the same folder only the new runs are made, the others are kept.
+    out = run([exe, "study", bench, "--case", case, "--add-method", "galpha:rho_inf=0.5", "--jobs", "2", "--no-plots", "-o", study])
+    expect = f"study {bench}: 5 runs made, {checked} kept from earlier, 0 stopped at the per-run budget, 0 failed"
+    if expect not in out:
+        fail(f"--add-method: expected '{expect}' in\n{out}")
+    with open(os.path.join(study, "study.csv")) as f:
+        added = sorted(r["group"] + "/" + r["label"] for r in csv.DictReader(f) if r["label"].startswith("galpha_rho_inf=0.5"))
+    want = sorted([f"window/galpha_rho_inf=0.5_dt={d}" for d in preset["dt_labels"]] +
+                  ["full/galpha_rho_inf=0.5" + (f"_dt={preset['full_dt_label']}" if preset["full_dt"] else "")])
+    if added != want:
+        fail(f"--add-method: rows {added}, expected {want}")
     print(f"{bench}: {checked} runs, the same labels, t_end, steps, RHS evaluations, factorizations, nonlinear "
           f"iterations and output times as the old preset")
 

@@ -160,6 +160,17 @@ TEST(StudyFile, AddedMethodJoinsTheSweepAndTheFullRuns) {
             std::string::npos);
 }
 
+// A reference that is also a sweep run: the same label twice, refused before any run with the study file named.
+TEST(StudyFile, ReferenceRepeatingASweepRunIsRefused) {
+  const StudyPreset p = parse("case: flying-plate.yaml\nwindow: {t_end: 0.04, dt: [0.01], reference: em-galpha:dt=0.01}\nmethods: [em-galpha]\n");
+  try {
+    planned(p, {"window"});
+    FAIL() << "the repeated run was accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_EQ(std::string(e.what()).rfind("s.yaml: window: run 'em-galpha_dt=0.01' is listed twice (the reference, a sweep value", 0), 0u) << e.what();
+  }
+}
+
 TEST(StudyFile, OptionalMethodOfAnotherBuildIsLeftOut) {
   const StudyPreset p = parse(kHead + "methods: [em-galpha, {name: no-such-scheme, optional: true}]\nheadline: [no-such-scheme]\n");
   ASSERT_EQ(p.methods.size(), 1u);
@@ -209,9 +220,11 @@ TEST(StudyFile, ErrorsNameFileLineAndKey) {
   for (const auto& c : cases) {
     const std::string got = error_of(c.text);
     EXPECT_EQ(got.rfind(c.message, 0), 0u) << "file:\n" << c.text << "\nexpected: " << c.message << "\ngot:      " << got;
-    // One line, plus indented detail lines where the registry lists the valid settings.
+    // One line, plus a "valid: ..." line where the registry lists the valid names.
     const auto newline = got.find('\n');
-    if (newline != std::string::npos) EXPECT_EQ(got.substr(newline + 1, 7), "valid: ") << got;
+    if (newline != std::string::npos) {
+      EXPECT_EQ(got.substr(newline + 1, 7), "valid: ") << got;
+    }
     EXPECT_LE(std::count(got.begin(), got.end(), '\n'), 1) << got;
   }
 }
