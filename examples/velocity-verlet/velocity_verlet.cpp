@@ -51,24 +51,34 @@ class VelocityVerlet final : public Integrator {
 
   StepReport advance(SemiDiscreteSystem& sys, State& s, double t_out) override {
     StepReport rep;
-    while (s.t < t_out - 1e-9 * h_) {
+    while (t_out - s.t > 1e-12 * h_) {
       if (stop_requested()) break;                        // at a step boundary: the driver checkpoints
       rep.chart_switches += sys.rechart(s, hysteresis_);  // between steps only (converts u, v, a)
-      const double h = std::min(h_, t_out - s.t);         // the last step lands on t_out
+      // The last step lands exactly on t_out and absorbs the round-off of summing steps (no sliver steps).
+      const bool last = t_out - s.t <= h_ * (1.0 + 1e-6);
+      const double h = last ? t_out - s.t : h_;
       sys.external(s.t, s.u, s.charts, f_ext_.data());    // F_ext,n in the current charts
       v_half_ = s.v + 0.5 * h * s.a;
       du_ = h * v_half_;
       u_new_ = s.u + du_;
       v_pred_ = v_half_ + 0.5 * h * s.a;
-      acceleration(sys, s.t + h, u_new_, v_pred_, s.charts, f_ext_new_, a_new_);
-      if (!a_new_.allFinite())
-        throw StepFailure("velocity-verlet: non-finite acceleration at t = " + std::to_string(s.t + h) +
-                          " (step " + std::to_string(h) + " above the critical step? raise substeps)");
+      // An explicit step above the critical step blows up: say so, whatever the system reports (e.g. a director
+      // turned beyond its chart) or the solve gives (non-finite numbers).
+      const auto where = [&] {
+        return "velocity-verlet: step to t = " + std::to_string(s.t + h) + " (h = " + std::to_string(h) +
+               ", above the critical step? raise substeps): ";
+      };
+      try {
+        acceleration(sys, s.t + h, u_new_, v_pred_, s.charts, f_ext_new_, a_new_);
+      } catch (const std::exception& e) {
+        throw StepFailure(where() + e.what());
+      }
+      if (!a_new_.allFinite()) throw StepFailure(where() + "non-finite acceleration");
       w_ext_ += 0.5 * (f_ext_ + f_ext_new_).dot(du_);
       s.u = u_new_;
       s.v = v_half_ + 0.5 * h * a_new_;
       s.a = a_new_;
-      s.t += h;
+      s.t = last ? t_out : s.t + h;
       ++rep.steps;
       ++rep.factorizations;
       ++rep.rhs_evaluations;

@@ -430,7 +430,8 @@ void write_compare_summaries(const CompareOptions& o, const Problem& first, doub
             << "," << s.totals.rejected_steps << "," << s.totals.nonlinear_iterations << "," << s.totals.linear_setups << ","
             << s.totals.factorizations << "," << s.totals.rhs_evaluations << "," << s.totals.chart_switches << ","
             << full(s.wall_seconds) << "," << full(s.cpu_seconds) << "," << full(s.t_ref) << "," << full(r.energy_error) << ","
-            << full(t_end >= loads_end ? s.max_rel_drift : std::nan("")) << "," << full(s.max_dL) << "," << full(s.max_dJ)
+            << full(t_end >= loads_end ? s.max_rel_drift : std::nan("")) << "," << full(t_end >= loads_end ? s.max_dL : std::nan(""))
+            << "," << full(t_end >= loads_end ? s.max_dJ : std::nan(""))
             << "," << full(s.ref_L) << "," << full(s.ref_J);
         for (const auto& m : result.monitors) {
           double v = std::nan("");
@@ -483,7 +484,8 @@ void write_compare_summaries(const CompareOptions& o, const Problem& first, doub
           if (name == mon) final_mon = value;
         md << s.totals.steps << " | " << s.totals.nonlinear_iterations << " | " << s.totals.factorizations << " | "
            << num(s.wall_seconds) << " | " << num(s.cpu_seconds) << " | " << (std::isnan(r.energy_error) ? "n/a" : num(r.energy_error)) << " | "
-           << num(s.max_dL) << " | " << num(s.max_dJ) << " | " << num(final_mon) << " | "
+           << (t_end >= loads_end ? num(s.max_dL) : "n/a") << " | " << (t_end >= loads_end ? num(s.max_dJ) : "n/a") << " | "
+           << num(final_mon) << " | "
            << (std::isnan(r.displacement_error) ? "n/a" : num(r.displacement_error)) << " | complete |\n";
       } else {
         md << "– | – | – | – | – | – | – | – | – | – | " << md_cell(r.status) << " |\n";
