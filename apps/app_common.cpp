@@ -352,6 +352,7 @@ int BenchmarkApp::main(int argc, char** argv) {
     print_error(std::cerr, name_ + ": ", e.what());
     return e.exit_code();
   } catch (const std::exception& e) {
+    record_failure(e.what());  // a held result folder still "incomplete: running" gets the reason (lib/result_folder.hpp)
     print_error(std::cerr, name_ + ": error: ", e.what());
     return 1;
   }

@@ -765,6 +765,7 @@ int main(int argc, char** argv) {
     app::print_error(std::cerr, "shelldyn: ", e.what());
     return e.exit_code();
   } catch (const std::exception& e) {
+    record_failure(e.what());  // a held result folder still "incomplete: running" gets the reason (lib/result_folder.hpp)
     app::print_error(std::cerr, "shelldyn: error: ", e.what());
     return 1;
   } catch (...) {  // e.g. a plugin throwing something that is not a std::exception

@@ -369,7 +369,7 @@ Discretization build_discretization(const CaseSpec& spec) {
   // Before the matrices are allocated: a model that cannot fit is refused with the estimate (lib/result_folder.hpp).
   try {
     check_memory_estimate(n, mesh.num_elements(), "",
-                          "use a coarser mesh, or a machine with more memory (--max-memory sets the limit)");
+                          "use a coarser mesh or raise --max-memory");
   } catch (const std::exception& e) {
     fail(spec.mesh_where, e.what());
   }

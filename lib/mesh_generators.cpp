@@ -63,7 +63,7 @@ void require_int_nodes(const std::string& gen, std::int64_t nodes) {
                            "; reduce the element counts");
   // Before the node arrays are allocated (lib/result_folder.hpp): a grid of quad9 elements has ~nodes/4 elements.
   try {
-    check_memory_estimate(nodes, nodes / 4, "", "reduce the element counts (or raise --max-memory)");
+    check_memory_estimate(nodes, nodes / 4, "", "reduce the element counts");
   } catch (const std::runtime_error& e) {
     bad_parameter(gen, e.what());
   }

@@ -351,28 +351,54 @@ std::string read_run_status(const std::string& dir) {
   }
 }
 
+namespace {
+// Sets run.json "status" (and optionally "resume_failed") of `dir` when its status is `only_if` (empty: always).
+void patch_run_json(const std::string& dir, const std::string& only_if, const std::string& status,
+                    const std::string& resume_failed) {
+  const std::string path = (fs::path(dir) / "run.json").string();
+  const std::string text = read_text(path);
+  if (text.empty()) return;
+  auto j = nlohmann::json::parse(text);
+  if (!j.is_object()) return;
+  const std::string now = j.value("status", std::string());
+  if (!only_if.empty() && now != only_if) return;
+  if (!status.empty()) j["status"] = status;
+  if (!resume_failed.empty()) j["resume_failed"] = resume_failed;
+  const std::string out = j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
+  const std::string tmp = path + ".tmp";
+  {
+    std::ofstream f(tmp, std::ios::binary | std::ios::trunc);
+    f << out;
+    if (!f) {
+      std::remove(tmp.c_str());
+      return;
+    }
+  }
+  if (std::rename(tmp.c_str(), path.c_str()) != 0) std::remove(tmp.c_str());
+}
+}  // namespace
+
 void record_failed_resume(const std::string& dir, const std::string& previous_status, const std::string& reason) noexcept {
   try {
-    const std::string path = (fs::path(dir) / "run.json").string();
-    const std::string text = read_text(path);
-    if (text.empty()) return;
-    auto j = nlohmann::json::parse(text);
-    if (!j.is_object()) return;
-    const std::string now = j.value("status", std::string());
     // The resume's own "incomplete: running" says nothing true: the folder still holds the run as it was.
-    if (now == "incomplete: running" && !previous_status.empty()) j["status"] = previous_status;
-    j["resume_failed"] = reason;
-    const std::string out = j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
-    const std::string tmp = path + ".tmp";
+    if (!previous_status.empty()) patch_run_json(dir, "incomplete: running", previous_status, "");
+    patch_run_json(dir, "", "", reason);
+  } catch (...) {
+  }
+}
+
+void record_failure(const std::string& reason) noexcept {
+  try {
+    std::vector<std::string> dirs;
     {
-      std::ofstream f(tmp, std::ios::binary | std::ios::trunc);
-      f << out;
-      if (!f) {
-        std::remove(tmp.c_str());
-        return;
-      }
+      Registry& r = registry();
+      std::lock_guard<std::mutex> g(r.m);
+      for (const auto& [key, h] : r.held) dirs.push_back(h.dir);
     }
-    if (std::rename(tmp.c_str(), path.c_str()) != 0) std::remove(tmp.c_str());
+    std::string one = reason;
+    for (char& c : one)
+      if (c == '\n' || c == '\r') c = ' ';
+    for (const auto& d : dirs) patch_run_json(d, "incomplete: running", "incomplete: " + one, "");
   } catch (...) {
   }
 }
@@ -482,7 +508,7 @@ void check_memory_estimate(long long nodes, long long elements, const std::strin
   const long long lim = g_memory_limit > 0 ? g_memory_limit : available_memory_bytes();
   if (lim <= 0 || need <= static_cast<double>(lim)) return;
   throw std::runtime_error((where.empty() ? std::string() : where + ": ") + std::to_string(nodes) + " nodes need at least " +
-                           memory_text(need) + " of memory (estimate), more than " +
+                           memory_text(need) + ", more than " +
                            (g_memory_limit > 0 ? "--max-memory " : "the available ") + memory_text(static_cast<double>(lim)) +
                            "; " + fix);
 }

@@ -88,6 +88,11 @@ std::string read_run_status(const std::string& dir);
 // contents are still that run's — and records "resume_failed": reason. Best effort (never throws).
 void record_failed_resume(const std::string& dir, const std::string& previous_status, const std::string& reason) noexcept;
 
+// The command failed with `reason` (called by the CLI's error handler): every folder this process holds whose
+// run.json still says "incomplete: running" — the command failed before the run could record why — gets
+// "incomplete: <reason>". Best effort (never throws).
+void record_failure(const std::string& reason) noexcept;
+
 // Why DIR has no checkpoint.cbor, as one line for `shelldyn resume` (the run completed, never wrote one, ...).
 std::string explain_missing_checkpoint(const std::string& dir);
 

@@ -180,7 +180,7 @@ StepReport SundialsBaseline::advance(SemiDiscreteSystem& system, State& state, d
       os.precision(3);
       os << name_ << ": crawling at t = " << t_ << " (";
       if (below >= 1000.0)
-        os << "1000 steps in a row below dt_min = " << dt_min << ", the last " << last_step();
+        os << "1000 steps below dt_min = " << dt_min << ", last " << last_step();
       else
         os << taken << " steps since t = " << t_start << ", more than the interval / dt_min = " << dt_min;
       os << "); raise rtol, lower dt_min or use a fixed-step integrator";

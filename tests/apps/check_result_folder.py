@@ -14,6 +14,8 @@ CHECK is one of
   complete        `resume` of a finished run says the run is complete (not "no checkpoint here")
   changed-case    `resume` after the case file was edited is refused; with --allow-changed-case it continues
   coincident      a mesh with coincident unmerged nodes: `check` warns, naming the nodes
+  failed-run      a run that fails before its first step (history.csv cannot be created) records the reason in
+                  run.json instead of "incomplete: running"
 """
 import json
 import os
@@ -137,6 +139,16 @@ def main():
         if len(w) != 1 or "(1 & 9, 2 & 12, 5 & 16, first at (2, 0, 0))" not in w[0]:
             fail(f"expected one warning naming the coincident nodes, stderr: {r.stderr!r}")
         print("OK: " + w[0])
+    elif check == "failed-run":
+        d = os.path.join(work, "run")
+        os.makedirs(os.path.join(d, "history.csv"))  # a folder where the file should go (not empty)
+        open(os.path.join(d, "history.csv", "keep"), "w").write("x")
+        open(os.path.join(d, "run.json"), "w").write('{"status": "complete"}\n')
+        line = one_error_line(run(exe, ["run", case] + short + ["--overwrite", "-o", d], code=1), "history")
+        status = json.load(open(os.path.join(d, "run.json")))["status"]
+        if not status.startswith("incomplete: ") or "history" not in status:
+            fail(f"run.json status {status!r} does not say why the run failed")
+        print(f"OK: {line}; run.json: {status!r}")
     else:
         fail("unknown check " + check)
 
