@@ -249,8 +249,9 @@ StaticReport StaticSolver::solve(State& state, double lambda_end, const Observer
       inc.arc_length = arc;
       inc.negative_pivots = pivots;
       inc.event = event;
-      if (!event.empty() && !report.critical_points.empty() && report.critical_points.back().step == report.levels)
-        inc.event_note = report.critical_points.back().note;
+      if (!event.empty())
+        for (const auto& cp : report.critical_points)
+          if (cp.step == report.levels) inc.event_note += (inc.event_note.empty() ? "" : "; ") + cp.note;
       observer(state, inc);
     }
     cuts = level_iterations = level_switches = 0;
@@ -482,7 +483,8 @@ StaticReport StaticSolver::solve(State& state, double lambda_end, const Observer
     auto add_point = [&](const std::string& kind, double estimate, const std::string& text) {
       CriticalPoint cp;
       cp.step = report.levels + 1;
-      cp.kind = event = kind;
+      cp.kind = kind;
+      event += (event.empty() ? "" : "; ") + kind;
       cp.load_factor = lam;
       cp.estimate = estimate;
       cp.pivots_before = before;
@@ -539,8 +541,7 @@ StaticReport StaticSolver::solve(State& state, double lambda_end, const Observer
       note << "path jump: the path tangent turned by " << turn << " degrees within one step (between " << o.parameter_name << " " << lam_n
            << " and " << lam << ", step " << report.levels + 1 << ", at the smallest step locate_tol x the first)"
            << ": the path is not resolved there (a kink, or a jump to another branch); check the results past it";
-      if (event.empty()) add_point("path jump", lam, note.str());
-      else report.critical_points.back().note += "; " + note.str();
+      add_point("path jump", lam, note.str());
     }
     last_values = r.values;
     report_point(r, event);

@@ -97,7 +97,7 @@ struct StaticIncrement {
   double arc_length = 0.0;       // cumulative ‖Δd‖₂ along the path
   long negative_pivots = 0;      // inertia of the converged tangent (-1: back-end cannot tell)
   std::string event;             // "", "limit point", "bifurcation point", "critical point", "snap-through",
-                                 // "path jump"
+                                 // "path jump"; several in one step are joined by "; "
   std::string event_note;        // the critical point's one-line note (with its λ) when event is set
 };
 

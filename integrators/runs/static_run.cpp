@@ -231,6 +231,7 @@ std::vector<StaticRow> run_static(Problem& problem, const std::string& out_dir, 
   info.summary.set("control", path_control_name(options.control));
   info.summary.set("max_load_factor", report.max_load_factor);
   info.summary.set("critical_points", static_cast<int>(report.critical_points.size()));
+  info.summary.set("steps_cut_back", report.located_cuts);  // to locate critical points or follow sharp turns
   for (size_t k = 0; k < report.critical_points.size(); ++k) {
     const auto& cp = report.critical_points[k];
     const std::string key = "critical_point_" + std::to_string(k + 1);
@@ -240,8 +241,16 @@ std::vector<StaticRow> run_static(Problem& problem, const std::string& out_dir, 
     info.summary.set(key + "_estimate", cp.estimate);
     info.summary.set(key + "_note", cp.note);
   }
-  if (log)
+  if (log) {
     for (const auto& cp : report.critical_points) *log << "critical point at step " << cp.step << ": " << cp.note << std::endl;
+    // A path jump means the path was not resolved there: everything past it may lie on another branch.
+    for (const auto& cp : report.critical_points)
+      if (cp.kind == "path jump") {
+        *log << "warning: the path jumped at step " << cp.step << " (" << options.parameter_name << " " << cp.load_factor
+             << "); the results past it may lie on another branch (check with a smaller increment or max_turn)" << std::endl;
+        break;
+      }
+  }
   if (reserve) reserve->release();
   if (!out_dir.empty()) write_run_json(out_dir + "/run.json", spec, info);
   if (report_out) *report_out = report;

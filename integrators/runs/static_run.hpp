@@ -29,7 +29,7 @@ struct StaticRow {
   int newton_iterations = 0;
   double arc_length = 0.0;       // cumulative ‖Δd‖₂ of the translations along the path
   long negative_pivots = 0;      // inertia of the converged tangent
-  std::string event;             // "", "limit point", "bifurcation point", "critical point", "snap-through"
+  std::string event;             // "", "limit point", "bifurcation point", "critical point", "snap-through", "path jump" (several: joined by "; ")
 };
 
 // out_dir empty: no files. log may be null. Returns the converged increments (the initial state is
