@@ -362,6 +362,7 @@ StaticReport StaticSolver::solve(State& state, double lambda_end, const Observer
   Eigen::VectorXd t_n(n), t_end(n), u(n);
   double dlam_prev = 1.0, dlam_prevprev = 1.0;
   double crossing_within = 0.0;  // a critical point lies within this step length of the state (0: none known)
+  double dl_resume = 0.0;        // the step size when the crossing was found: resumed once it is located
   double target = 0.0;
   // dλ/ds at a state with tangent t = K⁻¹F̂ along the path direction `dir`: arc length s = ‖Δd‖ (the sign
   // that the predictor takes), displacement control s = the controlled displacement in the step direction.
@@ -455,7 +456,10 @@ StaticReport StaticSolver::solve(State& state, double lambda_end, const Observer
         // A critical point inside the step (bisection), or a turn too sharp to trust: retry shorter.
         ++report.located_cuts;
         ++cuts;
-        if (crossed) crossing_within = dl_try;
+        if (crossed) {
+          if (crossing_within == 0.0) dl_resume = dl_try;
+          crossing_within = dl_try;
+        }
         dl_try = std::max(dl_locate, dl_try * (crossed ? 0.5 : std::clamp(o.max_turn / turn, 0.1, 0.5)));
         pivots = inertia_here();
         continue;
@@ -492,7 +496,8 @@ StaticReport StaticSolver::solve(State& state, double lambda_end, const Observer
       cp.note = text;
       report.critical_points.push_back(cp);
     };
-    if (before >= 0 && pivots >= 0 && pivots != before) {
+    const bool located = before >= 0 && pivots >= 0 && pivots != before;
+    if (located) {
       // A located change of inertia: a limit point when dλ/ds changes sign over the step, else a bifurcation.
       crossing_within = 0.0;
       std::ostringstream note;
@@ -549,6 +554,10 @@ StaticReport StaticSolver::solve(State& state, double lambda_end, const Observer
     double factor = std::sqrt(static_cast<double>(o.target_iterations) / std::max(1, r.iterations));
     if (turn > 0.0) factor = std::min(factor, o.max_turn / turn);
     dl = std::min(std::clamp(factor, 0.5, o.growth) * dl_try, o.max_arc_factor * dl0);
+    // Past a located critical point, resume the step size it was found with (not regrow from the tiny
+    // locating step); the turn control shortens it again where the path is still sharply curved.
+    if (located && dl_resume > dl) dl = std::min(dl_resume, o.max_arc_factor * dl0);
+    if (located) dl_resume = 0.0;
   }
   report.wall_seconds = std::chrono::duration<double>(Clock::now() - start).count();
   return report;
