@@ -45,9 +45,9 @@ double at_lambda(const std::vector<StaticRow>& rows, size_t a, size_t b, double 
 
 TEST(LimitPoints, PullOutCylinderSnapIsTracedWithTheDefaultIncrement) {
   // The case file as shipped: arc length with the default increment (time.dt = 0.025). The snap near
-  // P/P_max = 0.5 is a narrow loop (a maximum 0.5004, then a minimum 0.4879, measured with increment 0.001
-  // and max_arc_factor 1); before the step control of the turning tangent, every step size above ~0.002
-  // jumped over it with no event.
+  // P/P_max = 0.5 is a narrow loop: a maximum 0.500383, then a minimum 0.487875, as located with increment
+  // 0.001 and max_arc_factor 1 (108 steps). Before the step control of the turning tangent and the
+  // location by bisection, the default increment jumped over it with no event.
   Problem p = make_problem(load_case(case_path("sze-pullout-cylinder.yaml")));
   StaticReport rep;
   const auto rows = run_static(p, "", nullptr, &rep);
@@ -55,8 +55,8 @@ TEST(LimitPoints, PullOutCylinderSnapIsTracedWithTheDefaultIncrement) {
   const auto limits = points_of_kind(rep, "limit point");
   ASSERT_EQ(limits.size(), 2u) << "the snap of the pull-out cylinder was stepped over";
   EXPECT_EQ(rep.critical_points.size(), 2u);
-  EXPECT_NEAR(limits[0]->estimate, 0.50043, 5e-4);  // the maximum
-  EXPECT_NEAR(limits[1]->estimate, 0.48791, 5e-4);  // the minimum
+  EXPECT_NEAR(limits[0]->estimate, 0.500383, 1e-4);  // the maximum
+  EXPECT_NEAR(limits[1]->estimate, 0.487875, 1e-4);  // the minimum
   EXPECT_EQ(limits[0]->pivots_before, 0);
   EXPECT_EQ(limits[0]->pivots_after, 1);
   EXPECT_EQ(limits[1]->pivots_after, 0);
@@ -98,8 +98,8 @@ TEST(LimitPoints, DisplacementControlOverTheSnapFindsLimitPointsNotABifurcation)
   EXPECT_TRUE(points_of_kind(rep, "bifurcation point").empty());
   const auto limits = points_of_kind(rep, "limit point");
   ASSERT_EQ(limits.size(), 2u);
-  EXPECT_NEAR(limits[0]->estimate, 0.50043, 5e-4);  // the same limit loads as arc length finds
-  EXPECT_NEAR(limits[1]->estimate, 0.48791, 5e-4);
+  EXPECT_NEAR(limits[0]->estimate, 0.500383, 1e-4);  // the same limit loads as arc length finds
+  EXPECT_NEAR(limits[1]->estimate, 0.487875, 1e-4);
   EXPECT_NEAR(rows.back().monitors[0], 2.6, 1e-9);
 }
 
