@@ -557,7 +557,7 @@ StaticReport StaticSolver::solve(State& state, double lambda_end, const Observer
     // Past a located critical point, resume the step size it was found with (not regrow from the tiny
     // locating step); the turn control shortens it again where the path is still sharply curved.
     if (located && dl_resume > dl) dl = std::min(dl_resume, o.max_arc_factor * dl0);
-    if (located) dl_resume = 0.0;
+    if (located || crossing_within == 0.0) dl_resume = 0.0;
   }
   report.wall_seconds = std::chrono::duration<double>(Clock::now() - start).count();
   return report;

@@ -121,6 +121,26 @@ TEST(LimitPoints, AStepThatMayNotBeCutIsReportedAsAPathJump) {
   EXPECT_TRUE(flagged);  // static.csv's event column
 }
 
+TEST(LimitPoints, EulerColumnIsABifurcationPointAtItsBucklingLoad) {
+  // The Sze 3.1 strip (EI = 100, L = 10, clamped) under an axial end force P_max = 4: the straight path
+  // stays straight and λ keeps rising, while the tangent gets a negative pivot at the Euler load
+  // P_cr = π² EI / (4 L²) = 2.4674, λ = π²/16 = 0.61685. A bifurcation point, located, not a limit point.
+  CaseSpec spec = load_case(case_path("sze-cantilever-shear.yaml"));
+  spec.loads[0].direction = Vec3(-1.0, 0.0, 0.0);
+  spec.integrator.settings = {{"control", "arc_length"}};
+  spec.output.vtu = false;
+  Problem p = make_problem(spec);
+  StaticReport rep;
+  const auto rows = run_static(p, "", nullptr, &rep);
+  for (const auto& cp : rep.critical_points) std::printf("  %s\n", cp.note.c_str());
+  ASSERT_EQ(rep.critical_points.size(), 1u);
+  EXPECT_EQ(rep.critical_points[0].kind, "bifurcation point");
+  const double euler = 3.14159265358979323846 * 3.14159265358979323846 / 16.0;
+  EXPECT_NEAR(rep.critical_points[0].estimate, euler, 0.005 * euler);  // measured 0.616637 (-0.03 %)
+  EXPECT_NEAR(rows.back().load_factor, 1.0, 1e-12);
+  EXPECT_EQ(rows.back().negative_pivots, 1);
+}
+
 TEST(LimitPoints, ArcLengthFollowsRampLoadsBelowZero) {
   // The thin hinged roof (Sze §3.8, h = 6.35, P/4 = 250 at P_max) snaps back below P = 0: a ramp is zero
   // for λ < 0, which left the arc length without a load to follow (18 failed attempts and a false
