@@ -5,7 +5,9 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdio>
 #include <cmath>
+#include <iomanip>
 #include <memory>
 #include <sstream>
 #include <stdexcept>
@@ -56,6 +58,7 @@ struct StepResult {
   bool converged = false;
   int iterations = 0, factorizations = 0;
   long max_pivots = 0;  // largest negative-pivot count of the tangents met during the iterations
+  bool no_load_pattern = false;  // failed because F̂ = ∂F_ext/∂λ vanished (not a critical point)
   ConvergenceTest::Values values;
   std::string message;
 };
@@ -75,14 +78,35 @@ StaticReport StaticSolver::solve(State& state, double lambda_end, const Observer
   auto solver = make_linear_solver(o.linear_solver);
   Eigen::VectorXd fint(n), fext(n), fext2(n), R(n), du_r(n), du_f(n), fhat(n);
 
+  // F_ext(λ, u), extended to λ < 0 as an odd function when every load is a ramp (a reversed load; a ramp
+  // itself is zero there, which would leave a path that dips below λ = 0 with no load to follow).
+  SparseMatrix K_load;
+  auto external = [&](double lam, const Eigen::VectorXd& u, const std::vector<DirectorChart>& charts, double* F) {
+    if (o.odd_load_extension && lam < 0.0) {
+      model_.external(-lam, u, charts, F);
+      Eigen::Map<Eigen::VectorXd>(F, n) *= -1.0;
+    } else {
+      model_.external(lam, u, charts, F);
+    }
+  };
+  auto add_load_stiffness = [&](double lam, const Eigen::VectorXd& u, const std::vector<DirectorChart>& charts) {
+    if (o.odd_load_extension && lam < 0.0) {  // −sym ∂F_ext(λ)/∂q = +sym ∂F_ext(−λ)/∂q
+      if (K_load.values.empty()) K_load = model_.make_matrix();
+      K_load.set_zero();
+      model_.add_load_stiffness(-lam, u, charts, K_load);
+      for (size_t i = 0; i < K.values.size(); ++i) K.values[i] -= K_load.values[i];
+    } else {
+      model_.add_load_stiffness(lam, u, charts, K);
+    }
+  };
   // F_ext(λ, u) and, on request, F̂ = ∂F_ext/∂λ by a forward difference (exact for ramps).
   auto load_vectors = [&](double lam, const Eigen::VectorXd& u, const std::vector<DirectorChart>& charts, bool want_fhat) {
-    model_.external(lam, u, charts, fext.data());
+    external(lam, u, charts, fext.data());
     if (want_fhat) {
       // Forward difference (exact for ramps from λ = 0); backward at and beyond lambda_end, where a ramp ends.
       const double h0 = 1e-7 * std::max(1.0, std::abs(lam));
       const double h = lam + h0 > lambda_end ? -h0 : h0;
-      model_.external(lam + h, u, charts, fext2.data());
+      external(lam + h, u, charts, fext2.data());
       fhat = (fext2 - fext) / h;
       zero_constrained(dofs, fhat.data());
     }
@@ -91,7 +115,7 @@ StaticReport StaticSolver::solve(State& state, double lambda_end, const Observer
   auto evaluate = [&](const Eigen::VectorXd& u, double lam, const std::vector<DirectorChart>& charts,
                       const Eigen::VectorXd& u_n, const Eigen::VectorXd* du, ConvergenceTest::Values& v) {
     model_.internal(u, charts, fint.data(), nullptr);
-    model_.external(lam, u, charts, fext.data());
+    external(lam, u, charts, fext.data());
     R = fint - fext;
     v.force_ref = std::max(fext.norm(), fint.norm());
     zero_constrained(dofs, R.data());
@@ -118,11 +142,24 @@ StaticReport StaticSolver::solve(State& state, double lambda_end, const Observer
   };
   auto factorize_tangent = [&](const Eigen::VectorXd& u, double lam, const std::vector<DirectorChart>& charts) {
     model_.internal(u, charts, nullptr, &K);
-    model_.add_load_stiffness(lam, u, charts, K);
+    add_load_stiffness(lam, u, charts);
     apply_dirichlet(dofs, K, nullptr);
     solver->factorize(K.view());
     ++report.jacobian_evaluations;
     return solver->negative_pivots();
+  };
+
+  // A progress line while a long step iterates (the pinched cylinder 48 × 48 needs minutes per step).
+  auto last_line = Clock::now();
+  auto maybe_progress = [&](int iteration, double residual, double lam) {
+    if (!o.progress) return;
+    const auto now = Clock::now();
+    if (std::chrono::duration<double>(now - last_line).count() < o.progress_seconds) return;
+    last_line = now;
+    char buf[200];
+    std::snprintf(buf, sizeof buf, "  ... step %d: Newton iteration %d, |R| = %.3g, %s %.6g, %.0f s", report.levels + 1,
+                  iteration, residual, o.parameter_name.c_str(), lam, std::chrono::duration<double>(now - start).count());
+    o.progress(buf);
   };
 
   // One Newton solve from the predictor (u, lam) about the converged (u_n, lam_n).
@@ -151,6 +188,12 @@ StaticReport StaticSolver::solve(State& state, double lambda_end, const Observer
         if (mode != PathControl::load) {
           load_vectors(lam, u, charts, true);
           solver->solve(fhat.data(), du_f.data());
+          if (!(translational_norm(du_f, trans) > 0.0)) {
+            s.no_load_pattern = true;
+            s.message = "the load pattern dF_ext/d" + std::string(o.parameter_name == "load factor" ? "lambda" : "t") + " is zero at " +
+                        o.parameter_name + " " + std::to_string(lam) + " (the loads' time functions are constant there: no load to follow)";
+            return s;
+          }
           if (mode == PathControl::arc_length) {
             if (!arc_length_root(u - u_n, du_r, du_f, trans, dl, &dlam)) {
               s.message = "the arc-length constraint has no real root (cut the arc length)";
@@ -171,6 +214,7 @@ StaticReport StaticSolver::solve(State& state, double lambda_end, const Observer
         lam += dlam;
         have_du = true;
         ++s.iterations;
+        maybe_progress(s.iterations, s.values.residual, lam);
       }
     } catch (const std::exception& e) {
       s.converged = false;
@@ -193,6 +237,7 @@ StaticReport StaticSolver::solve(State& state, double lambda_end, const Observer
   auto report_point = [&](const StepResult& r, const std::string& event) {
     ++report.levels;
     report.max_load_factor = std::max(report.max_load_factor, state.t);
+    last_line = Clock::now();
     if (observer) {
       StaticIncrement inc;
       inc.step = report.levels;
@@ -204,6 +249,9 @@ StaticReport StaticSolver::solve(State& state, double lambda_end, const Observer
       inc.arc_length = arc;
       inc.negative_pivots = pivots;
       inc.event = event;
+      if (!event.empty())
+        for (const auto& cp : report.critical_points)
+          if (cp.step == report.levels) inc.event_note += (inc.event_note.empty() ? "" : "; ") + cp.note;
       observer(state, inc);
     }
     cuts = level_iterations = level_switches = 0;
@@ -212,7 +260,7 @@ StaticReport StaticSolver::solve(State& state, double lambda_end, const Observer
     std::ostringstream msg;
     msg << "static solver gave up at " << o.parameter_name << " " << state.t << " (step " << report.levels + 1 << "): "
         << what << " " << size << " failed and the next is below min_increment " << min_size << "; last failure: " << r.message;
-    if (pivots > 0 || r.max_pivots > 0)
+    if ((pivots > 0 || r.max_pivots > 0) && !r.no_load_pattern)
       msg << "; the tangent has " << pivots << " negative pivots at the last converged state and up to " << r.max_pivots
           << " during the failed iterations: a limit or bifurcation point is near"
           << (o.control == PathControl::load ? " (trace it with control: arc_length)" : "");
@@ -231,8 +279,8 @@ StaticReport StaticSolver::solve(State& state, double lambda_end, const Observer
       // Tangent prediction of this increment with K at the converged state (factorized by inertia_here()):
       // the converged increment is compared with it to detect a jump (snap-through) to a remote branch.
       if (switches) pivots = inertia_here();
-      model_.external(lambda, state.u, state.charts, fext2.data());
-      model_.external(state.t, state.u, state.charts, fext.data());
+      external(lambda, state.u, state.charts, fext2.data());
+      external(state.t, state.u, state.charts, fext.data());
       fhat = fext2 - fext;
       zero_constrained(dofs, fhat.data());
       solver->solve(fhat.data(), du_f.data());
@@ -298,23 +346,36 @@ StaticReport StaticSolver::solve(State& state, double lambda_end, const Observer
     return report;
   }
 
-  // --- arc length and displacement control ---
+  // --- arc length and displacement control (docs/guide/statics-limit-points.md) ---
   load_vectors(state.t, state.u, state.charts, true);
   // With a back-end that cannot report inertia (klu: pivots = -1) the path is still traced, but critical
-  // points are not detected.
+  // points are found only from reversals of λ.
   solver->solve(fhat.data(), du_f.data());
   const double df_norm = translational_norm(du_f, trans);
   if (!(df_norm > 0.0)) throw std::runtime_error("static solver: the load pattern dF_ext/dlambda is zero at " + o.parameter_name + " " + std::to_string(state.t) + " (no loads to follow)");
   const double dl0 = o.control == PathControl::arc_length ? o.increment * df_norm : std::abs(o.increment);
+  const double dl_locate = o.locate_tol * dl0;  // a crossing step this short locates its critical point
+  const double dsign = o.increment > 0 ? 1.0 : -1.0;
+  const double kDeg = 180.0 / 3.14159265358979323846;
   double dl = dl0;
   Eigen::VectorXd du_prev = du_f;  // direction of the first step: increasing λ
+  Eigen::VectorXd t_n(n), t_end(n), u(n);
   double dlam_prev = 1.0, dlam_prevprev = 1.0;
-  bool pending_change = false;
-  int change_step = 0;
-  long change_before = 0;
-  double change_lambda = 0.0;
+  double crossing_within = 0.0;  // a critical point lies within this step length of the state (0: none known)
+  double dl_resume = 0.0;        // the step size when the crossing was found: resumed once it is located
   double target = 0.0;
-  const double dsign = o.increment > 0 ? 1.0 : -1.0;
+  // dλ/ds at a state with tangent t = K⁻¹F̂ along the path direction `dir`: arc length s = ‖Δd‖ (the sign
+  // that the predictor takes), displacement control s = the controlled displacement in the step direction.
+  auto slope = [&](const Eigen::VectorXd& t, const Eigen::VectorXd& dir) {
+    if (o.control == PathControl::arc_length)
+      return (translational_dot(t, dir, trans) >= 0.0 ? 1.0 : -1.0) / translational_norm(t, trans);
+    return dsign / t[o.control_dof];
+  };
+  // Angle between the path tangents t_a and t_b (translations; their sign flips at a limit point).
+  auto turn_angle = [&](const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
+    const double c = std::abs(translational_dot(a, b, trans)) / (translational_norm(a, trans) * translational_norm(b, trans));
+    return std::isfinite(c) ? std::acos(std::min(1.0, c)) * kDeg : 0.0;
+  };
   for (int step = 0;; ++step) {
     if (state.t >= lambda_end - eps) break;
     if (o.control == PathControl::displacement && std::isfinite(o.displacement_end) &&
@@ -329,23 +390,36 @@ StaticReport StaticSolver::solve(State& state, double lambda_end, const Observer
     const int switches = model_.rechart(state, o.rechart_hysteresis);
     report.chart_switches += switches;
     level_switches += switches;
-    // Predictor along K⁻¹F̂ at the converged state (factorized by inertia_here()).
+    // Predictor along t_n = K⁻¹F̂ at the converged state (factorized by inertia_here()).
     load_vectors(state.t, state.u, state.charts, true);
     if (switches) pivots = inertia_here();
-    solver->solve(fhat.data(), du_f.data());
+    solver->solve(fhat.data(), t_n.data());
+    if (!(translational_norm(t_n, trans) > 0.0)) {
+      std::ostringstream msg;
+      msg << "static solver: the load pattern dF_ext/d" << (o.parameter_name == "load factor" ? "lambda" : "t") << " is zero at "
+          << o.parameter_name << " " << state.t << " (step " << report.levels + 1
+          << "): the loads' time functions are constant there, so there is no load to follow (use ramps, or end "
+             "time.t_end where the loads stop changing)";
+      throw std::runtime_error(msg.str());
+    }
     StepResult r;
-    Eigen::VectorXd u;
-    double lam = 0.0;
+    double lam = 0.0, dl_try = dl;
+    // Bisection towards a known crossing: half of what is left of the bracket, never below the locating size.
+    if (crossing_within > 0.0) dl_try = std::min(dl, std::max(dl_locate, 0.5 * crossing_within));
+    long p_end = pivots;
+    double turn = 0.0;
+    bool jump = false;
     for (;;) {
+      du_f = t_n;
       u = state.u;
       lam = state.t;
       double dlam;
       if (o.control == PathControl::arc_length) {
         const double sign = translational_dot(du_f, du_prev, trans) >= 0.0 ? 1.0 : -1.0;
-        dlam = sign * dl / translational_norm(du_f, trans);
+        dlam = sign * dl_try / translational_norm(du_f, trans);
       } else {
-        double step_d = dsign * dl;
-        if (std::isfinite(o.displacement_end)) step_d = dsign * std::min(dl, dsign * (o.displacement_end - state.u[o.control_dof]));
+        double step_d = dsign * dl_try;
+        if (std::isfinite(o.displacement_end)) step_d = dsign * std::min(dl_try, dsign * (o.displacement_end - state.u[o.control_dof]));
         target = state.u[o.control_dof] + step_d;
         if (!(std::abs(du_f[o.control_dof]) > 0.0))
           throw std::runtime_error("static solver: the controlled DOF does not respond to the load at " + o.parameter_name + " " +
@@ -360,85 +434,130 @@ StaticReport StaticSolver::solve(State& state, double lambda_end, const Observer
       }
       u += dlam * du_f;
       lam += dlam;
-      r = newton(u, lam, state.u, state.charts, dl, target, mode);
+      r = newton(u, lam, state.u, state.charts, dl_try, target, mode);
       report.newton_iterations += r.iterations;
-      if (r.converged) break;
-      ++report.failed_attempts;
-      ++cuts;
-      dl *= 0.5;
-      if (dl < o.min_increment * dl0) give_up(o.control == PathControl::arc_length ? "arc length" : "displacement increment", dl * 2, o.min_increment * dl0, r);
-      pivots = inertia_here();  // restore the factorization at the converged state for the next predictor
-      load_vectors(state.t, state.u, state.charts, true);
-      solver->solve(fhat.data(), du_f.data());
+      if (!r.converged) {
+        ++report.failed_attempts;
+        ++cuts;
+        dl_try *= 0.5;
+        if (dl_try < o.min_increment * dl0)
+          give_up(o.control == PathControl::arc_length ? "arc length" : "displacement increment", dl_try * 2, o.min_increment * dl0, r);
+        pivots = inertia_here();  // restore the factorization at the converged state
+        continue;
+      }
+      // The end of the step: its inertia and path tangent (the factorization is kept for the next predictor).
+      p_end = factorize_tangent(u, lam, state.charts);
+      load_vectors(lam, u, state.charts, true);
+      solver->solve(fhat.data(), t_end.data());
+      turn = turn_angle(t_n, t_end);
+      const bool crossed = pivots >= 0 && p_end >= 0 && (p_end != pivots || r.max_pivots > std::max(pivots, p_end));
+      const bool sharp = turn > 2.0 * o.max_turn;
+      if ((crossed || sharp) && dl_try > dl_locate) {
+        // A critical point inside the step (bisection), or a turn too sharp to trust: retry shorter.
+        ++report.located_cuts;
+        ++cuts;
+        if (crossed) {
+          if (crossing_within == 0.0) dl_resume = dl_try;
+          crossing_within = dl_try;
+        }
+        dl_try = std::max(dl_locate, dl_try * (crossed ? 0.5 : std::clamp(o.max_turn / turn, 0.1, 0.5)));
+        pivots = inertia_here();
+        continue;
+      }
+      jump = sharp;
+      break;
     }
-    const double dlam_step = lam - state.t;
-    du_prev = u - state.u;
-    arc += translational_norm(du_prev, trans);
+    const double lam_n = state.t, dlam_step = lam - state.t;
+    const Eigen::VectorXd du_step = u - state.u;
+    const double h = o.control == PathControl::arc_length ? translational_norm(du_step, trans) : std::abs(du_step[o.control_dof]);
+    const double g0 = slope(t_n, du_prev), g1 = slope(t_end, du_step);
+    du_prev = du_step;
+    arc += translational_norm(du_step, trans);
     state.u = u;
     state.t = lam;
     ++report.increments;
     level_iterations += r.iterations;
     path.emplace_back(arc, lam);
+    if (crossing_within > 0.0) crossing_within = std::max(0.0, crossing_within - h);
     const long before = pivots;
-    pivots = inertia_here();
+    pivots = p_end;
     dlam_prevprev = dlam_prev;
     dlam_prev = dlam_step;
     std::string event;
-    // Critical points: a reversal of λ is a limit point (at the previous point, the extremum); a change of
-    // the negative pivots not followed by a reversal within two steps is a bifurcation point.
-    if (before >= 0 && pivots >= 0 && pivots != before) {
-      pending_change = true;
-      change_step = report.levels + 1;
-      change_before = before;
-      change_lambda = lam;
-    }
-    const bool reversed = step > 0 && (dlam_prev > 0) != (dlam_prevprev > 0) && dlam_prev != 0.0;
-    if (reversed) {
+    auto add_point = [&](const std::string& kind, double estimate, const std::string& text) {
       CriticalPoint cp;
       cp.step = report.levels + 1;
-      cp.kind = event = "limit point";
-      const auto& p0 = path[path.size() - 3 < path.size() ? path.size() - 3 : 0];
-      const auto& p1 = path[path.size() - 2];
-      const auto& p2 = path[path.size() - 1];
-      cp.load_factor = cp.estimate = p1.second;
-      if (path.size() >= 3) {
-        // Parabola λ(s) through the three points around the extremum.
-        const double d1 = (p1.second - p0.second) / (p1.first - p0.first), d2 = (p2.second - p1.second) / (p2.first - p1.first);
-        const double a = (d2 - d1) / (p2.first - p0.first);
-        const double b = d1 - a * (p0.first + p1.first);
-        const double c = p0.second - a * p0.first * p0.first - b * p0.first;
-        const double sm = a != 0.0 ? -b / (2 * a) : p1.first;
-        if (a != 0.0 && sm >= p0.first && sm <= p2.first) cp.estimate = a * sm * sm + b * sm + c;
+      cp.kind = kind;
+      event += (event.empty() ? "" : "; ") + kind;
+      cp.load_factor = lam;
+      cp.estimate = estimate;
+      cp.pivots_before = before;
+      cp.pivots_after = pivots;
+      cp.note = text;
+      report.critical_points.push_back(cp);
+    };
+    const bool located = before >= 0 && pivots >= 0 && pivots != before;
+    if (located) {
+      // A located change of inertia: a limit point when dλ/ds changes sign over the step, else a bifurcation.
+      crossing_within = 0.0;
+      std::ostringstream note;
+      if ((g0 > 0.0) != (g1 > 0.0)) {
+        // Extremum of λ(s): λ' varies about linearly over the short step, zero at s* = h g0/(g0 − g1).
+        const double s_star = std::isfinite(g0 / (g0 - g1)) ? h * g0 / (g0 - g1) : 0.5 * h;
+        double est = lam_n + 0.5 * g0 * s_star;
+        est = g0 > 0.0 ? std::max({est, lam_n, lam}) : std::min({est, lam_n, lam});
+        note << "limit point: " << o.parameter_name << " " << (g0 > 0.0 ? "maximum" : "minimum") << " " << est << " (located to "
+             << std::setprecision(2) << std::max(std::abs(lam - lam_n), std::abs(est - lam)) << std::setprecision(6) << " in step "
+             << report.levels + 1 << "; negative pivots " << before << " -> " << pivots << ")";
+        add_point("limit point", est, note.str());
+      } else {
+        const double est = 0.5 * (lam_n + lam);
+        note << "bifurcation point at " << o.parameter_name << " " << est << " (located to " << std::setprecision(2)
+             << 0.5 * std::abs(lam - lam_n) << std::setprecision(6) << " in step " << report.levels + 1 << "; negative pivots " << before << " -> " << pivots << ", " << o.parameter_name
+             << " still " << (g0 > 0.0 ? "rising" : "falling") << "); the solver stays on the primary path (no branch switching)";
+        add_point("bifurcation point", est, note.str());
       }
-      cp.pivots_before = pending_change ? change_before : pivots;
-      cp.pivots_after = pivots;
+    } else if (before < 0 || pivots < 0) {
+      // No inertia (klu): a reversal of λ is a limit point, estimated by a parabola λ(s) through the three
+      // points around the extremum.
+      const bool reversed = step > 0 && (dlam_prev > 0) != (dlam_prevprev > 0) && dlam_prev != 0.0;
+      if (reversed) {
+        const auto& p0 = path[path.size() >= 3 ? path.size() - 3 : 0];
+        const auto& p1 = path[path.size() - 2];
+        const auto& p2 = path[path.size() - 1];
+        double est = p1.second;
+        if (path.size() >= 3) {
+          const double d1 = (p1.second - p0.second) / (p1.first - p0.first), d2 = (p2.second - p1.second) / (p2.first - p1.first);
+          const double a = (d2 - d1) / (p2.first - p0.first);
+          const double b = d1 - a * (p0.first + p1.first);
+          const double c = p0.second - a * p0.first * p0.first - b * p0.first;
+          const double sm = a != 0.0 ? -b / (2 * a) : p1.first;
+          if (a != 0.0 && sm >= p0.first && sm <= p2.first) est = a * sm * sm + b * sm + c;
+        }
+        std::ostringstream note;
+        note << "limit point: " << o.parameter_name << " " << (dlam_prevprev > 0 ? "maximum" : "minimum") << " ~ " << est
+             << " between steps " << report.levels << " and " << report.levels + 1
+             << " (this linear solver reports no inertia: limit points are found from reversals only, bifurcation points not at all)";
+        add_point("limit point", est, note.str());
+      }
+    }
+    if (jump) {
       std::ostringstream note;
-      note << "limit point: " << o.parameter_name << " reached a " << (dlam_prevprev > 0 ? "maximum" : "minimum") << " ~ "
-           << cp.estimate << " between steps " << report.levels << " and " << report.levels + 1 << " (negative pivots "
-           << cp.pivots_before << " -> " << pivots << (pending_change || pivots < 0 ? ")" : "; no inertia change seen: check the step size)");
-      cp.note = note.str();
-      report.critical_points.push_back(cp);
-      pending_change = false;
-    } else if (pending_change && report.levels + 1 - change_step >= 2) {
-      CriticalPoint cp;
-      cp.step = change_step;
-      cp.load_factor = cp.estimate = change_lambda;
-      cp.kind = event = "bifurcation point";
-      cp.pivots_before = change_before;
-      cp.pivots_after = pivots;
-      std::ostringstream note;
-      note << "bifurcation point near " << o.parameter_name << " " << change_lambda << " (negative pivots " << change_before
-           << " changed at step " << change_step << " without a reversal of " << o.parameter_name
-           << "); the solver stays on the primary path (no branch switching)";
-      cp.note = note.str();
-      report.critical_points.push_back(cp);
-      pending_change = false;
+      note << "path jump: the path tangent turned by " << turn << " degrees within one step (between " << o.parameter_name << " " << lam_n
+           << " and " << lam << ", step " << report.levels + 1 << ", at the smallest step locate_tol x the first)"
+           << ": the path is not resolved there (a kink, or a jump to another branch); check the results past it";
+      add_point("path jump", lam, note.str());
     }
     last_values = r.values;
     report_point(r, event);
-    // Adapt the step size to the iteration count.
-    const double factor = std::clamp(std::sqrt(static_cast<double>(o.target_iterations) / std::max(1, r.iterations)), 0.5, o.growth);
-    dl = std::min(dl * factor, o.max_arc_factor * dl0);
+    // The next step: sized to the iteration count and to the turn of the tangent (about max_turn per step).
+    double factor = std::sqrt(static_cast<double>(o.target_iterations) / std::max(1, r.iterations));
+    if (turn > 0.0) factor = std::min(factor, o.max_turn / turn);
+    dl = std::min(std::clamp(factor, 0.5, o.growth) * dl_try, o.max_arc_factor * dl0);
+    // Past a located critical point, resume the step size it was found with (not regrow from the tiny
+    // locating step); the turn control shortens it again where the path is still sharply curved.
+    if (located && dl_resume > dl) dl = std::min(dl_resume, o.max_arc_factor * dl0);
+    if (located || crossing_within == 0.0) dl_resume = 0.0;
   }
   report.wall_seconds = std::chrono::duration<double>(Clock::now() - start).count();
   return report;

@@ -23,11 +23,26 @@
 //                  its projection on the previous increment; Δl adapted to `target_iterations` and halved
 //                  on failure. Δl of the first step makes its predictor Δλ = `increment`.
 //   displacement:  the DOF `control_dof` is prescribed in steps of `increment` (length units), λ follows.
-// Critical points (arc length, displacement): a reversal of λ is a limit point (its load estimated by a
-// parabola λ(s) through the three points around the extremum); a change of the number of negative pivots
-// of the converged tangent not followed by a reversal within two steps is a bifurcation point (branch
-// switching is not done: the solver stays on the primary path). The last arc-length step is solved under
-// load control at exactly lambda_end.
+// Step control (arc length, displacement; docs/guide/statics-limit-points.md): besides the iteration count,
+// a converged step is accepted only when
+//   - the path tangent t = K⁻¹F̂ (translations) turns by at most 2·max_turn between its ends (else it is
+//     retried shorter: a sharp snap is resolved, not jumped over), and the next step is sized so that the
+//     tangent turns by about max_turn;
+//   - the inertia of the tangent (its negative pivots) is the same at both ends and no Newton iterate met
+//     more negative pivots than the ends. Otherwise a critical point lies inside the step: the step is cut
+//     back by bisection until the step that crosses it is shorter than locate_tol × the first step, and
+//     the critical point is reported there (a loop of two limit points inside one step is split the same
+//     way). Its kind follows from the sign of dλ/ds at the two ends (the sign of the determinant of the
+//     bordered arc-length system is sign(dλ/ds)·(−1)^pivots): a limit point when dλ/ds changes sign, a
+//     bifurcation point when it does not (no branch switching: the solver stays on the primary path). The
+//     λ of a limit point is the extremum of the cubic Hermite interpolant of λ(s) over the crossing step.
+// A step whose tangent still turns by more than 2·max_turn at the smallest step is accepted and reported
+// as a "path jump" (a warning: the path is not resolved there). With a back-end that cannot report the
+// inertia (klu) a reversal of λ marks a limit point. The last arc-length step is solved under load control
+// at exactly lambda_end.
+//
+// Loads: when every load is a ramp (λ is a load factor), F_ext is extended to λ < 0 as an odd function
+// (F_ext(−λ) = −F_ext(λ), a reversed load) so that a path through negative loads stays traceable.
 #pragma once
 
 #include "integrators/nonlinear/path_following.hpp"
@@ -56,6 +71,13 @@ struct StaticOptions {
   int max_steps = 1000;           // arc length / displacement: give up after this many steps
   int max_iters = 30;             // Newton iterations per step
   double jump_ratio = 5.0;        // load: a converged increment longer than this × the tangent prediction is a jump
+  double max_turn = 10.0;         // arc length / displacement: target turn of the path tangent per step, degrees
+  double locate_tol = 0.01;       // arc length / displacement: a critical point is located to this × the first step
+  bool odd_load_extension = false;  // F_ext(−λ) = −F_ext(λ) for λ < 0 (every load a ramp: λ is a load factor)
+  // Progress of long steps: called with a one-line message at most every progress_seconds while a step's
+  // Newton iterations run (the observer's lines count as progress). Null: silent.
+  std::function<void(const std::string&)> progress;
+  double progress_seconds = 5.0;
   ConvergenceTest convergence;
   std::string linear_solver = "eigen-ldlt";
   double rechart_hysteresis = 1.0;
@@ -74,13 +96,16 @@ struct StaticIncrement {
   double residual_norm = 0.0;    // ‖R_free‖₂ at the converged point
   double arc_length = 0.0;       // cumulative ‖Δd‖₂ along the path
   long negative_pivots = 0;      // inertia of the converged tangent (-1: back-end cannot tell)
-  std::string event;             // "", "limit point", "bifurcation point", "critical point", "snap-through"
+  std::string event;             // "", "limit point", "bifurcation point", "critical point", "snap-through",
+                                 // "path jump"; several in one step are joined by "; "
+  std::string event_note;        // the critical point's one-line note (with its λ) when event is set
 };
 
 struct CriticalPoint {
   int step = 0;                  // reported point at which it was detected (just past it)
   double load_factor = 0.0;      // λ at that point
-  double estimate = 0.0;         // limit point: parabolic estimate of the maximum λ; else = load_factor
+  double estimate = 0.0;         // λ of the located point (limit point: the extremum of λ; else the midpoint
+                                 // of the crossing step)
   std::string kind;              // as StaticIncrement::event
   long pivots_before = 0, pivots_after = 0;
   std::string note;              // one line for logs and run.json
@@ -95,7 +120,8 @@ struct StaticReport {
   int chart_switches = 0;
   double wall_seconds = 0.0;
   double max_load_factor = 0.0;
-  std::vector<CriticalPoint> critical_points;
+  std::vector<CriticalPoint> critical_points;  // limit / bifurcation / critical points, snaps and path jumps
+  int located_cuts = 0;          // steps cut back to locate critical points or to follow a sharp turn
 };
 
 class StaticSolver {

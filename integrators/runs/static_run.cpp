@@ -63,6 +63,9 @@ StaticOptions static_options(const CaseSpec& spec, const Discretization* disc) {
   o.rechart_hysteresis = s.get("hysteresis", 1.0);
   o.max_iters = s.get("max_iters", 30);
   o.jump_ratio = s.get("jump_ratio", 5.0);
+  o.max_turn = s.get("max_turn", 10.0);
+  o.locate_tol = s.get("locate_tol", 0.01);
+  o.progress_seconds = s.get("progress_seconds", 5.0);
   o.convergence.residual_tol = s.get("tol", 1e-8);
   o.convergence.increment_tol = s.get("step_tol", 1e-10);
   o.linear_solver = s.get("linear_solver", std::string("eigen-ldlt"));
@@ -87,6 +90,13 @@ StaticOptions static_options(const CaseSpec& spec, const Discretization* disc) {
   bool proportional = true;
   for (const auto& l : spec.loads) proportional = proportional && l.function.kind() == TimeFunction::Kind::Ramp;
   o.parameter_name = proportional ? "load factor" : "pseudo-time t";
+  o.odd_load_extension = proportional && !spec.loads.empty();  // a reversed load below λ = 0 (static_solver.hpp)
+  if (!(o.max_turn > 0.0 && o.max_turn < 90.0))
+    throw std::invalid_argument("integrator.max_turn: " + std::to_string(o.max_turn) + " is not an angle in (0, 90) degrees");
+  if (!(o.locate_tol > 0.0 && o.locate_tol <= 1.0))
+    throw std::invalid_argument("integrator.locate_tol: " + std::to_string(o.locate_tol) + " must lie in (0, 1] (a fraction of the first step)");
+  if (!(o.progress_seconds >= 0.0))
+    throw std::invalid_argument("integrator.progress_seconds: " + std::to_string(o.progress_seconds) + " must be >= 0");
   return o;
 }
 
@@ -94,7 +104,8 @@ std::vector<StaticRow> run_static(Problem& problem, const std::string& out_dir, 
                                   StaticReport* report_out, const State* start) {
   const CaseSpec& spec = problem.spec;
   check_prescribed_motion_support(spec, "static", false);  // load stepping follows no time history
-  const StaticOptions options = static_options(spec, &problem.disc);
+  StaticOptions options = static_options(spec, &problem.disc);
+  if (log) options.progress = [log](const std::string& line) { *log << line << std::endl; };
   Model& model = *problem.model;
   // Follower loads have a non-symmetric tangent: in full with the LU solver (quadratic Newton), else its
   // symmetric part (docs/theory.md §8.2).
@@ -193,7 +204,7 @@ std::vector<StaticRow> run_static(Problem& problem, const std::string& out_dir, 
                       inc.load_factor, inc.newton_iterations, inc.cuts, inc.chart_switches, inc.negative_pivots);
         *log << buf;
         for (size_t k = 0; k < monitors.size(); ++k) *log << "  " << monitors[k].name << " " << rows.back().monitors[k];
-        if (!inc.event.empty()) *log << "  ** " << inc.event;
+        if (!inc.event.empty()) *log << "  ** " << (inc.event_note.empty() ? inc.event : inc.event_note);
         *log << std::endl;
       }
     });
@@ -220,6 +231,7 @@ std::vector<StaticRow> run_static(Problem& problem, const std::string& out_dir, 
   info.summary.set("control", path_control_name(options.control));
   info.summary.set("max_load_factor", report.max_load_factor);
   info.summary.set("critical_points", static_cast<int>(report.critical_points.size()));
+  info.summary.set("steps_cut_back", report.located_cuts);  // to locate critical points or follow sharp turns
   for (size_t k = 0; k < report.critical_points.size(); ++k) {
     const auto& cp = report.critical_points[k];
     const std::string key = "critical_point_" + std::to_string(k + 1);
@@ -229,8 +241,16 @@ std::vector<StaticRow> run_static(Problem& problem, const std::string& out_dir, 
     info.summary.set(key + "_estimate", cp.estimate);
     info.summary.set(key + "_note", cp.note);
   }
-  if (log)
+  if (log) {
     for (const auto& cp : report.critical_points) *log << "critical point at step " << cp.step << ": " << cp.note << std::endl;
+    // A path jump means the path was not resolved there: everything past it may lie on another branch.
+    for (const auto& cp : report.critical_points)
+      if (cp.kind == "path jump") {
+        *log << "warning: the path jumped at step " << cp.step << " (" << options.parameter_name << " " << cp.load_factor
+             << "); the results past it may lie on another branch (check with a smaller increment or max_turn)" << std::endl;
+        break;
+      }
+  }
   if (reserve) reserve->release();
   if (!out_dir.empty()) write_run_json(out_dir + "/run.json", spec, info);
   if (report_out) *report_out = report;

@@ -16,7 +16,8 @@ namespace shelldyn {
 // Reads the `integrator: {name: static, ...}` settings (docs/statics.md): control (load | arc_length |
 // displacement), increment (default time.dt), min_increment, growth, easy_iterations, target_iterations,
 // max_arc_factor, max_steps, max_iters, tol (residual relative to F_ref, default 1e-8), step_tol (increment
-// relative to the displacement scale, default 1e-10), linear_solver, hysteresis, and for displacement
+// relative to the displacement scale, default 1e-10), linear_solver, hysteresis, max_turn (degrees,
+// default 10), locate_tol (default 0.01), progress_seconds (default 5), and for displacement
 // control control_set (one node), control_dof (ux|uy|uz), displacement_end. `disc` resolves control_set
 // (may be null when control is not displacement).
 StaticOptions static_options(const CaseSpec& spec, const Discretization* disc = nullptr);
@@ -28,7 +29,7 @@ struct StaticRow {
   int newton_iterations = 0;
   double arc_length = 0.0;       // cumulative ‖Δd‖₂ of the translations along the path
   long negative_pivots = 0;      // inertia of the converged tangent
-  std::string event;             // "", "limit point", "bifurcation point", "critical point", "snap-through"
+  std::string event;             // "", "limit point", "bifurcation point", "critical point", "snap-through", "path jump" (several: joined by "; ")
 };
 
 // out_dir empty: no files. log may be null. Returns the converged increments (the initial state is
