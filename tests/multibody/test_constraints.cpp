@@ -206,6 +206,57 @@ TEST(Constraints, BadReferencesAndDuplicateNamesAreRefused) {
   EXPECT_THROW(distance("rod", PointMap::vector3(0), PointMap::vector3(3), -1.0), std::invalid_argument);
 }
 
+// §2.4: the discrete constraint forces −Ḡᵀλ of a joint between bodies have zero resultant and zero moment about
+// the origin, taken with the midpoint configuration, on two consistent states — which is what keeps L and J of a
+// conserving step. Gonzalez's generic formula applied to the distance does not have the property (it adds a
+// multiple of Δq to the gradient); the invariant form does.
+TEST(Constraints, JointsBetweenBodiesExertNoDiscreteNetForceOrMoment) {
+  std::mt19937 rng(21);
+  const Vec3 rA(0.5, 0.1, -0.2), rB(-0.3, 0.2, 0.1), X1(0.2, -0.4, 0.3), X2(0.1, 0.3, -0.2);
+  auto consistent = [&](const Mat3& RA, double turn) {  // the bodies share the joint point and the d3 axis
+    const Mat3 RB = RA * Eigen::AngleAxisd(turn, Vec3::UnitZ()).toRotationMatrix();
+    const Vec3 xA = random_vec(rng);
+    Eigen::VectorXd q(24);
+    q << RigidBody::state(xA, RA), RigidBody::state(xA + RA * rA - RB * rB, RB);
+    return q;
+  };
+  const Eigen::VectorXd q0 = consistent(random_rotation(rng), 0.3), q1 = consistent(random_rotation(rng), -1.1);
+  std::vector<std::unique_ptr<Constraint>> kinds;
+  kinds.push_back(orthonormality("A frame", 0));
+  kinds.push_back(spherical_joint("ball", PointMap::body_point(0, rA), PointMap::body_point(12, rB)));
+  kinds.push_back(revolute_joint("hinge", PointMap::body_point(0, rA), PointMap::body_point(12, rB),
+                                 PointMap::body_vector(0, Vec3::UnitZ()), PointMap::body_vector(12, Vec3::UnitX()),
+                                 PointMap::body_vector(12, Vec3::UnitY())));
+  kinds.push_back(distance("rod", PointMap::body_point(0, X1), PointMap::body_point(12, X2), 1.0));
+  kinds.push_back(distance("rod (Gonzalez)", PointMap::body_point(0, X1), PointMap::body_point(12, X2), 1.0,
+                           DistanceGradient::gonzalez));
+  const Eigen::VectorXd qm = 0.5 * (q0 + q1);
+  for (const auto& c : kinds) {
+    if (c->type() != "distance") {
+      ASSERT_LT(c->g(q0, 0).norm() + c->g(q1, 0).norm(), 1e-14) << c->name();
+    }
+    std::vector<Triplet> t;
+    Eigen::VectorXd tau;
+    c->discrete_gradient(q0, 0.0, q1, 0.0, t, tau);
+    Eigen::SparseMatrix<double> B(c->size(), 24);
+    B.setFromTriplets(t.begin(), t.end());
+    Eigen::VectorXd mu(c->size());
+    for (int i = 0; i < c->size(); ++i) mu(i) = std::normal_distribution<double>(0, 1)(rng);
+    const Eigen::VectorXd f = B.transpose() * mu;
+    Vec3 force = Vec3::Zero(), moment = Vec3::Zero();
+    for (int a = 0; a < 8; ++a) {  // the eight 3-blocks (φ, d1, d2, d3) of the two bodies
+      if (a % 4 == 0) force += f.segment<3>(3 * a);
+      moment += Vec3(qm.segment<3>(3 * a)).cross(Vec3(f.segment<3>(3 * a)));
+    }
+    if (c->name() == "rod (Gonzalez)") {
+      EXPECT_GT(force.norm() + moment.norm(), 1e-3) << c->name();
+    } else {
+      EXPECT_LT(force.norm(), 1e-14) << c->name();
+      EXPECT_LT(moment.norm(), 1e-14) << c->name();
+    }
+  }
+}
+
 // Rank check (§2.5): a body pinned at two points is free only to turn about the line through them, so the 6 + 6
 // rows have rank 11; the check names both pins (and the frame rows they depend on), not the other body's joint.
 TEST(Constraints, RankCheckNamesTheJointsOfARedundantSet) {
