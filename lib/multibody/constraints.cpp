@@ -263,7 +263,7 @@ class PrescribedRotation : public Constraint {
   void discrete_gradient(const Eigen::VectorXd& q0, double t0, const Eigen::VectorXd& q1, double t1,
                          std::vector<Triplet>& out, Eigen::VectorXd& tau) const override {
     // Rows 0–4 are linear and time-independent: Ḡ = G, τ = 0. The drive row u(q)·w(t) is bilinear in
-    // (u, w): u1·w1 − u0·w0 = ½(w0 + w1)·(u1 − u0) + ½(u0 + u1)·(w1 − w0), §4.4 eq. (4.6).
+    // (u, w): u1·w1 − u0·w0 = ½(w0 + w1)·(u1 − u0) + ½(u0 + u1)·(w1 − w0), §4.4 eqs. (4.5)–(4.6).
     pivot_.add_block(0, 1.0, out);
     axis_.add_row(3, t1_, 1.0, out);
     axis_.add_row(4, t2_, 1.0, out);

@@ -1,7 +1,7 @@
-// End-to-end check of the construction on rigid bodies (docs/theory/multibody.md §5, §7): the conserving
+// End-to-end check of the construction on rigid bodies (docs/theory/multibody.md §5, §8): the conserving
 // director-form step with multipliers on the discrete gradient keeps the energy to solver tolerance, the momenta
 // exactly where no ground joint breaks them, and g = 0 at every step end; its trajectory converges at second
-// order to the independent RK45 reference; replacing Ḡ by the end-point Jacobian G(q_{n+1}) loses the energy.
+// order to the independent RK45 reference; replacing Ḡ by the end-point Jacobian G(q_{n+1}) loses the energy (§8).
 #include "director_step.hpp"
 #include "lib/multibody/rigid_reference.hpp"
 
