@@ -48,6 +48,17 @@ void PointMap::add_block(int row0, double scale, std::vector<Triplet>& out) cons
       if (c != 0.0) out.emplace_back(row0 + k, b + k, scale * c);
 }
 
+void PointMap::add_outer(const PointMap& y, const Eigen::Matrix3d& K, double scale, std::vector<Triplet>& out) const {
+  for (const auto& [bx, cx] : terms)
+    for (const auto& [by, cy] : y.terms) {
+      const double c = scale * cx * cy;
+      if (c == 0.0) continue;
+      for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j)
+          if (K(i, j) != 0.0) out.emplace_back(bx + i, by + j, c * K(i, j));
+    }
+}
+
 namespace {
 
 void collect(const PointMap& p, std::set<int>& s) {
@@ -133,6 +144,15 @@ class Revolute : public Constraint {
     e_.add_row(4, h, 1.0, out);
     h_.add_row(4, e, 1.0, out);
   }
+  void hessian_contraction(const Eigen::VectorXd&, double, const Eigen::VectorXd& lam,
+                           std::vector<Triplet>& out) const override {
+    // ∇²(e·f) couples the e and f blocks with the identity, both ways.
+    const Eigen::Matrix3d I = Eigen::Matrix3d::Identity();
+    e_.add_outer(f_, I, lam(3), out);
+    f_.add_outer(e_, I, lam(3), out);
+    e_.add_outer(h_, I, lam(4), out);
+    h_.add_outer(e_, I, lam(4), out);
+  }
 
  private:
   PointMap a_, b_, e_, f_, h_;
@@ -164,6 +184,17 @@ class Orthonormality : public Constraint {
       for (int k = 0; k < 3; ++k) {
         out.emplace_back(row, base_ + 3 + 3 * i + k, 0.5 * q(base_ + 3 + 3 * j + k));
         out.emplace_back(row, base_ + 3 + 3 * j + k, 0.5 * q(base_ + 3 + 3 * i + k));
+      }
+    }
+  }
+  void hessian_contraction(const Eigen::VectorXd&, double, const Eigen::VectorXd& lam,
+                           std::vector<Triplet>& out) const override {
+    // ∇²(½ d_i·d_j) = ½ I at (d_i, d_j) and at (d_j, d_i) — I at (d_i, d_i) when i = j.
+    for (int row = 0; row < 6; ++row) {
+      const auto [i, j] = pair(row);
+      for (int k = 0; k < 3; ++k) {
+        out.emplace_back(base_ + 3 + 3 * i + k, base_ + 3 + 3 * j + k, 0.5 * lam(row));
+        out.emplace_back(base_ + 3 + 3 * j + k, base_ + 3 + 3 * i + k, 0.5 * lam(row));
       }
     }
   }
@@ -209,8 +240,35 @@ class Distance : public Constraint {
     a_.add_row(0, w, 1.0, out);
     b_.add_row(0, w, -1.0, out);
   }
+  void hessian_contraction(const Eigen::VectorXd& q, double t, const Eigen::VectorXd& lam,
+                           std::vector<Triplet>& out) const override {
+    (void)t;
+    // ∇²|r| = (I − n nᵀ)/|r| in r, mapped by ∂r/∂q = ∂a/∂q − ∂b/∂q.
+    const Vec3 r = a_(q) - b_(q);
+    const Vec3 n = r / r.norm();
+    add_r_outer((Eigen::Matrix3d::Identity() - n * n.transpose()) / r.norm(), lam(0), out);
+  }
+  void discrete_tangent(const Eigen::VectorXd& q0, double t0, const Eigen::VectorXd& q1, double t1,
+                        const Eigen::VectorXd& lam, std::vector<Triplet>& out) const override {
+    if (form_ == DistanceGradient::gonzalez) {
+      Constraint::discrete_tangent(q0, t0, q1, t1, lam, out);
+      return;
+    }
+    // w = (r0 + r1)/s, s = |r0| + |r1|: ∂w/∂r1 = I/s − (r0 + r1) n1ᵀ/s² with n1 = r1/|r1|.
+    const Vec3 r0 = a_(q0) - b_(q0), r1 = a_(q1) - b_(q1);
+    const double s = r0.norm() + r1.norm();
+    const Vec3 n1 = r1 / r1.norm();
+    add_r_outer(Eigen::Matrix3d::Identity() / s - (r0 + r1) * n1.transpose() / (s * s), lam(0), out);
+  }
 
  private:
+  // scale · (∂r/∂q)ᵀ K (∂r/∂q) with r = a − b.
+  void add_r_outer(const Eigen::Matrix3d& K, double scale, std::vector<Triplet>& out) const {
+    a_.add_outer(a_, K, scale, out);
+    a_.add_outer(b_, K, -scale, out);
+    b_.add_outer(a_, K, -scale, out);
+    b_.add_outer(b_, K, scale, out);
+  }
   PointMap a_, b_;
   double L_;
   DistanceGradient form_;
@@ -307,6 +365,60 @@ void Constraint::discrete_gradient(const Eigen::VectorXd& q0, double t0, const E
   }
   // Linear: G is constant. Quadratic: g(q1) − g(q0) = G(q_mid)(q1 − q0) exactly (§2.2).
   jacobian(0.5 * (q0 + q1), t, out);
+}
+
+namespace {
+// Central differences of q ↦ B(q)ᵀλ over the constraint's unknowns (the general-kind fallback of §5.1).
+template <class F>
+void fd_tangent(const Constraint& c, const Eigen::VectorXd& q, const Eigen::VectorXd& lam, F&& rows,
+                std::vector<Triplet>& out) {
+  const std::vector<int> cols = c.unknowns();
+  auto product = [&](const Eigen::VectorXd& x) {
+    std::vector<Triplet> t;
+    rows(x, t);
+    Eigen::VectorXd f = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(cols.size()));
+    for (const auto& e : t) {
+      const auto it = std::lower_bound(cols.begin(), cols.end(), e.col());
+      f(it - cols.begin()) += e.value() * lam(e.row());
+    }
+    return f;
+  };
+  for (size_t k = 0; k < cols.size(); ++k) {
+    const double h = 1e-6 * (1.0 + std::abs(q(cols[k])));
+    Eigen::VectorXd qp = q, qm = q;
+    qp(cols[k]) += h;
+    qm(cols[k]) -= h;
+    const Eigen::VectorXd d = (product(qp) - product(qm)) / (2.0 * h);
+    for (size_t i = 0; i < cols.size(); ++i)
+      if (d(i) != 0.0) out.emplace_back(cols[i], cols[k], d(i));
+  }
+}
+}  // namespace
+
+void Constraint::hessian_contraction(const Eigen::VectorXd& q, double t, const Eigen::VectorXd& lam,
+                                     std::vector<Triplet>& out) const {
+  if (kind() == ConstraintKind::linear) return;
+  if (kind() == ConstraintKind::quadratic)
+    throw std::logic_error("constraint '" + name() + "' (" + type() + ") must define its Hessian");
+  fd_tangent(*this, q, lam, [&](const Eigen::VectorXd& x, std::vector<Triplet>& t_) { jacobian(x, t, t_); }, out);
+}
+
+void Constraint::discrete_tangent(const Eigen::VectorXd& q0, double t0, const Eigen::VectorXd& q1, double t1,
+                                  const Eigen::VectorXd& lam, std::vector<Triplet>& out) const {
+  if (kind() == ConstraintKind::linear) return;  // Ḡ = G does not depend on q (t enters rheonomic rows only)
+  if (kind() == ConstraintKind::quadratic) {
+    // Ḡ = G(q_mid): ∂(G(q_mid)ᵀλ)/∂q1 = ½ Σ λ_i H_i.
+    std::vector<Triplet> h;
+    hessian_contraction(0.5 * (q0 + q1), 0.5 * (t0 + t1), lam, h);
+    for (const auto& e : h) out.emplace_back(e.row(), e.col(), 0.5 * e.value());
+    return;
+  }
+  fd_tangent(*this, q1, lam,
+             [&](const Eigen::VectorXd& x, std::vector<Triplet>& t_) {
+               Eigen::VectorXd tau;
+               discrete_gradient(q0, t0, x, t1, t_, tau);
+             },
+             out);
 }
 
 void gonzalez_discrete_gradient(const Constraint& c, const Eigen::VectorXd& q0, const Eigen::VectorXd& q1,
@@ -450,6 +562,23 @@ Eigen::SparseMatrix<double> ConstraintSet::Gbar(const Eigen::VectorXd& q0, doubl
     tau.segment(offsets_[i], list_[i]->size()) = tl;
   }
   return assemble(rows_, n_, all);
+}
+
+Eigen::SparseMatrix<double> ConstraintSet::hessian_contraction(const Eigen::VectorXd& q, double t,
+                                                               const Eigen::VectorXd& lambda) const {
+  std::vector<Triplet> all;
+  for (size_t i = 0; i < list_.size(); ++i)
+    list_[i]->hessian_contraction(q, t, lambda.segment(offsets_[i], list_[i]->size()), all);
+  return assemble(n_, n_, all);
+}
+
+Eigen::SparseMatrix<double> ConstraintSet::discrete_tangent(const Eigen::VectorXd& q0, double t0,
+                                                            const Eigen::VectorXd& q1, double t1,
+                                                            const Eigen::VectorXd& lambda) const {
+  std::vector<Triplet> all;
+  for (size_t i = 0; i < list_.size(); ++i)
+    list_[i]->discrete_tangent(q0, t0, q1, t1, lambda.segment(offsets_[i], list_[i]->size()), all);
+  return assemble(n_, n_, all);
 }
 
 RankReport ConstraintSet::rank_check(const Eigen::VectorXd& q, double t, double tol, double g_tol) const {

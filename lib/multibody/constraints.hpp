@@ -44,6 +44,8 @@ struct PointMap {
   void add_row(int row, const Vec3& w, double scale, std::vector<Triplet>& out) const;
   // Appends scale · ∂x_k/∂q to rows row0 + k.
   void add_block(int row0, double scale, std::vector<Triplet>& out) const;
+  // Appends scale · (∂x/∂q)ᵀ K (∂y/∂q) for this map x and another map y (an n × n contribution).
+  void add_outer(const PointMap& y, const Eigen::Matrix3d& K, double scale, std::vector<Triplet>& out) const;
 };
 
 enum class ConstraintKind { linear, quadratic, general };
@@ -70,6 +72,17 @@ class Constraint {
   // degree ≤ 2), general uses gonzalez_discrete_gradient. Rheonomic kinds override it.
   virtual void discrete_gradient(const Eigen::VectorXd& q0, double t0, const Eigen::VectorXd& q1, double t1,
                                  std::vector<Triplet>& out, Eigen::VectorXd& tau) const;
+
+  // Newton tangents of the constraint force (§5.1), as n × n triplets over the global unknowns, for the
+  // multipliers `lambda` (size() entries):
+  //   hessian_contraction:  ∂(G(q, t)ᵀλ)/∂q = Σ_i λ_i ∇²g_i   (index-3 schemes with the end-point Jacobian);
+  //   discrete_tangent:     ∂(Ḡ(q0, q1)ᵀλ)/∂q1                (the conserving step).
+  // Linear kinds add nothing; quadratic kinds give the constant Σλ_i H_i and ½Σλ_i H_i. The defaults for a
+  // general kind are central differences over the constraint's unknowns; kinds override them where they can.
+  virtual void hessian_contraction(const Eigen::VectorXd& q, double t, const Eigen::VectorXd& lambda,
+                                   std::vector<Triplet>& out) const;
+  virtual void discrete_tangent(const Eigen::VectorXd& q0, double t0, const Eigen::VectorXd& q1, double t1,
+                                const Eigen::VectorXd& lambda, std::vector<Triplet>& out) const;
 
  private:
   std::string name_, type_;
@@ -143,6 +156,11 @@ class ConstraintSet {
   // Ḡ and τ of §2.2 stacked.
   Eigen::SparseMatrix<double> Gbar(const Eigen::VectorXd& q0, double t0, const Eigen::VectorXd& q1, double t1,
                                    Eigen::VectorXd& tau) const;
+  // The stacked tangents of §5.1 for the stacked multipliers lambda (rows() entries); n × n.
+  Eigen::SparseMatrix<double> hessian_contraction(const Eigen::VectorXd& q, double t,
+                                                  const Eigen::VectorXd& lambda) const;
+  Eigen::SparseMatrix<double> discrete_tangent(const Eigen::VectorXd& q0, double t0, const Eigen::VectorXd& q1,
+                                               double t1, const Eigen::VectorXd& lambda) const;
 
   // Row rank of G(q, t) by an SVD over the touched columns (§2.5): singular values ≤ tol · max(1, σ_max) count
   // as zero; the left null vectors name the constraints involved, and |yᵀ g(q, t)| > g_tol marks a conflict.

@@ -78,18 +78,13 @@ StepResult step(const DirectorSystem& s, const Eigen::VectorXd& q0, const Eigen:
   bool converged = false;
   for (int it = 1; it <= 40 && !converged; ++it) {
     residual(q1, mu, r);
-    // Saddle-point Jacobian [[(2/Δt)M + ∂(Bᵀμ)/∂q1, Bᵀ], [G(q1), 0]]; the curvature term by central differences
-    // (it is constant for quadratic constraints, so the differences are exact up to rounding).
+    // Saddle-point Jacobian [[(2/Δt)M + ∂(Bᵀμ)/∂q1, Bᵀ], [G(q1), 0]] with the constraints' force tangents
+    // (docs/theory/multibody.md §5.1).
     Eigen::MatrixXd K = Eigen::MatrixXd::Zero(n + m, n + m);
     K.topLeftCorner(n, n).diagonal() = (2.0 / dt) * M;
-    const double h = 1e-6 * scale;
-    for (int k = 0; k < n; ++k) {
-      Eigen::VectorXd qp = q1, qm = q1;
-      qp(k) += h;
-      qm(k) -= h;
-      K.block(0, k, n, 1) += (force_term(s, q0, t0, qp, t1, mu, choice, nullptr) -
-                              force_term(s, q0, t0, qm, t1, mu, choice, nullptr)) / (2.0 * h);
-    }
+    K.topLeftCorner(n, n) += Eigen::MatrixXd(choice == GradientChoice::discrete
+                                                 ? s.constraints.discrete_tangent(q0, t0, q1, t1, mu)
+                                                 : s.constraints.hessian_contraction(q1, t1, mu));
     Eigen::VectorXd tl;
     const Eigen::MatrixXd B = choice == GradientChoice::discrete
                                   ? Eigen::MatrixXd(s.constraints.Gbar(q0, t0, q1, t1, tl))

@@ -178,6 +178,47 @@ TEST(Constraints, JacobianAndTimeDerivativeMatchFiniteDifferences) {
   }
 }
 
+// §5.1: the Newton tangents of the constraint force against central differences of G(q)ᵀλ and Ḡ(q0, q1)ᵀλ.
+TEST(Constraints, ForceTangentsMatchFiniteDifferences) {
+  std::mt19937 rng(17);
+  const double h = 1e-6;
+  for (const auto& c : every_kind()) {
+    const Eigen::VectorXd q0 = random_state(rng, 1.0), q1 = q0 + random_state(rng, 0.3);
+    Eigen::VectorXd lam(c->size());
+    for (int i = 0; i < c->size(); ++i) lam(i) = std::normal_distribution<double>(0, 1)(rng);
+    auto GTl = [&](const Eigen::VectorXd& q) {
+      std::vector<Triplet> t;
+      c->jacobian(q, 0.4, t);
+      return Eigen::VectorXd(dense(*c, t).transpose() * lam);
+    };
+    auto GbTl = [&](const Eigen::VectorXd& q) {
+      std::vector<Triplet> t;
+      Eigen::VectorXd tau;
+      c->discrete_gradient(q0, 0.4, q, 0.45, t, tau);
+      return Eigen::VectorXd(dense(*c, t).transpose() * lam);
+    };
+    Eigen::MatrixXd fdH(kN, kN), fdT(kN, kN);
+    for (int k = 0; k < kN; ++k) {
+      Eigen::VectorXd qp = q1, qm = q1;
+      qp(k) += h;
+      qm(k) -= h;
+      fdH.col(k) = (GTl(qp) - GTl(qm)) / (2 * h);
+      fdT.col(k) = (GbTl(qp) - GbTl(qm)) / (2 * h);
+    }
+    std::vector<Triplet> th, tt;
+    c->hessian_contraction(q1, 0.4, lam, th);
+    c->discrete_tangent(q0, 0.4, q1, 0.45, lam, tt);
+    Eigen::SparseMatrix<double> H(kN, kN), T(kN, kN);
+    H.setFromTriplets(th.begin(), th.end());
+    T.setFromTriplets(tt.begin(), tt.end());
+    EXPECT_LT((Eigen::MatrixXd(H) - fdH).cwiseAbs().maxCoeff(), 1e-7) << c->name();
+    EXPECT_LT((Eigen::MatrixXd(T) - fdT).cwiseAbs().maxCoeff(), 1e-7) << c->name();
+    if (c->kind() != ConstraintKind::linear) {
+      EXPECT_GT(fdT.cwiseAbs().maxCoeff(), 1e-3) << c->name();  // the check compares something
+    }
+  }
+}
+
 TEST(Constraints, StackedSetMatchesTheKindsRowByRow) {
   ConstraintSet set(kN);
   for (auto& c : every_kind()) set.add(std::move(c));
