@@ -249,8 +249,8 @@ TEST(Constraints, BadReferencesAndDuplicateNamesAreRefused) {
 
 // §2.4: the discrete constraint forces −Ḡᵀλ of a joint between bodies have zero resultant and zero moment about
 // the origin, taken with the midpoint configuration, on two consistent states — which is what keeps L and J of a
-// conserving step. Gonzalez's generic formula applied to the distance does not have the property (it adds a
-// multiple of Δq to the gradient); the invariant form does.
+// conserving step. The distance is checked off its manifold (|r0| ≠ |r1| ≠ L), as in a Newton iterate: there the
+// invariant form (2.5) keeps the property and Gonzalez's generic formula (2.4) does not (§2.3).
 TEST(Constraints, JointsBetweenBodiesExertNoDiscreteNetForceOrMoment) {
   std::mt19937 rng(21);
   const Vec3 rA(0.5, 0.1, -0.2), rB(-0.3, 0.2, 0.1), X1(0.2, -0.4, 0.3), X2(0.1, 0.3, -0.2);
