@@ -581,23 +581,30 @@ Eigen::SparseMatrix<double> ConstraintSet::discrete_tangent(const Eigen::VectorX
   return assemble(n_, n_, all);
 }
 
-RankReport ConstraintSet::rank_check(const Eigen::VectorXd& q, double t, double tol, double g_tol) const {
+RankReport ConstraintSet::rank_check(const Eigen::VectorXd& q, double t, double tol, double g_tol,
+                                     const std::vector<bool>& fixed) const {
   RankReport rep;
   rep.rows = rows_;
   if (rows_ == 0) return rep;
-  // Dense G over the touched columns only: a shell model has many unknowns but few of them constrained.
+  if (!fixed.empty() && static_cast<int>(fixed.size()) != n_)
+    throw std::invalid_argument("ConstraintSet::rank_check: the fixed-unknown mask has " +
+                                std::to_string(fixed.size()) + " entries for " + std::to_string(n_) +
+                                " unknowns");
+  // Dense G over the touched free columns only: a shell model has many unknowns but few of them constrained.
   std::set<int> touched;
   for (const auto& c : list_)
-    for (int k : c->unknowns()) touched.insert(k);
+    for (int k : c->unknowns())
+      if (fixed.empty() || !fixed[k]) touched.insert(k);
   const std::vector<int> cols(touched.begin(), touched.end());
   const Eigen::SparseMatrix<double> Gs = G(q, t);
   Eigen::MatrixXd D = Eigen::MatrixXd::Zero(rows_, static_cast<Eigen::Index>(cols.size()));
   for (int k = 0; k < Gs.outerSize(); ++k)
     for (Eigen::SparseMatrix<double>::InnerIterator it(Gs, k); it; ++it) {
       const auto pos = std::lower_bound(cols.begin(), cols.end(), static_cast<int>(it.col()));
-      D(it.row(), pos - cols.begin()) += it.value();
+      if (pos != cols.end() && *pos == it.col()) D(it.row(), pos - cols.begin()) += it.value();
     }
-  const Eigen::JacobiSVD<Eigen::MatrixXd> svd(D, Eigen::ComputeFullU);
+  // Divide-and-conquer SVD: the clamp of a shell edge gives hundreds of rows, where Jacobi's is slow.
+  const Eigen::BDCSVD<Eigen::MatrixXd> svd(D, Eigen::ComputeFullU);
   const Eigen::VectorXd& s = svd.singularValues();
   const double cut = tol * std::max(1.0, s.size() ? s(0) : 0.0);
   int rank = 0;
@@ -626,12 +633,14 @@ RankReport ConstraintSet::rank_check(const Eigen::VectorXd& q, double t, double 
     }
   os << (rep.conflicting ? "; they cannot all hold: remove or correct one of them"
                          : "; remove one of them or free a direction it fixes twice");
+  if (!fixed.empty()) os << " (unknowns fixed by supports are not counted as free)";
   rep.message = os.str();
   return rep;
 }
 
-void ConstraintSet::require_full_rank(const Eigen::VectorXd& q, double t, double tol) const {
-  const RankReport r = rank_check(q, t, tol);
+void ConstraintSet::require_full_rank(const Eigen::VectorXd& q, double t, const std::vector<bool>& fixed,
+                                      double tol) const {
+  const RankReport r = rank_check(q, t, tol, 1e-9, fixed);
   if (!r.message.empty()) throw std::invalid_argument(r.message);
 }
 

@@ -164,9 +164,13 @@ class ConstraintSet {
 
   // Row rank of G(q, t) by an SVD over the touched columns (§2.5): singular values ≤ tol · max(1, σ_max) count
   // as zero; the left null vectors name the constraints involved, and |yᵀ g(q, t)| > g_tol marks a conflict.
-  RankReport rank_check(const Eigen::VectorXd& q, double t, double tol = 1e-10, double g_tol = 1e-9) const;
+  // `fixed` (empty, or one flag per unknown) drops the unknowns a support already prescribes: a joint acting
+  // only on such unknowns, or fixing again what a support fixes, is then reported as well.
+  RankReport rank_check(const Eigen::VectorXd& q, double t, double tol = 1e-10, double g_tol = 1e-9,
+                        const std::vector<bool>& fixed = {}) const;
   // Throws std::invalid_argument with RankReport::message if G is rank deficient.
-  void require_full_rank(const Eigen::VectorXd& q, double t, double tol = 1e-10) const;
+  void require_full_rank(const Eigen::VectorXd& q, double t, const std::vector<bool>& fixed = {},
+                         double tol = 1e-10) const;
 
  private:
   int n_;

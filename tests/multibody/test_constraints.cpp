@@ -341,6 +341,34 @@ TEST(Constraints, RankCheckNamesTheJointsOfARedundantSet) {
   EXPECT_NE(c.message.find("conflicting constraints"), std::string::npos) << c.message;
 }
 
+// A joint on unknowns a support already fixes: a node whose translations are Dirichlet-fixed and a fixed point
+// on that node. Over the free unknowns the joint's rows vanish, so the check names it; without the mask it
+// passes. A clamp of many nodes to a body is full rank.
+TEST(Constraints, RankCheckNamesAJointOnFixedUnknowns) {
+  constexpr int n = 12 + 3 * 40;
+  Eigen::VectorXd q = Eigen::VectorXd::Zero(n);
+  q.head<12>() = RigidBody::state(Vec3::Zero(), Mat3::Identity());
+  ConstraintSet s(n);
+  s.add(orthonormality("hub frame", 0));
+  for (int k = 0; k < 40; ++k) {
+    const Vec3 X(0.1 * k, 0.05 * (k % 3), 0.0);
+    s.add(spherical_joint("clamp " + std::to_string(k), PointMap::node_position(12 + 3 * k, X),
+                          PointMap::body_point(0, X)));
+  }
+  std::vector<bool> fixed(n, false);
+  EXPECT_TRUE(s.rank_check(q, 0.0, 1e-10, 1e-9, fixed).message.empty());
+  s.add(fixed_point("pin", PointMap::node_position(12 + 3 * 39, Vec3(3.9, 0.0, 0.0)), Vec3(3.9, 0.0, 0.0)));
+  // Without supports the pin only stops the clamped assembly's translation: full rank.
+  EXPECT_TRUE(s.rank_check(q, 0.0).message.empty());
+  for (int k = 0; k < 3; ++k) fixed[12 + 3 * 39 + k] = true;  // a support on node 39's translations
+  const RankReport r = s.rank_check(q, 0.0, 1e-10, 1e-9, fixed);
+  EXPECT_EQ(r.rows - r.rank, 3) << r.message;
+  EXPECT_NE(r.message.find("fixed point 'pin'"), std::string::npos) << r.message;
+  EXPECT_NE(r.message.find("fixed by supports"), std::string::npos) << r.message;
+  EXPECT_THROW(s.require_full_rank(q, 0.0, fixed), std::invalid_argument);
+  EXPECT_THROW(s.rank_check(q, 0.0, 1e-10, 1e-9, std::vector<bool>(5, false)), std::invalid_argument);
+}
+
 TEST(Constraints, RankCheckFlagsAHingeAddedToADrivenHub) {
   Eigen::VectorXd q(12);
   q = RigidBody::state(Vec3::Zero(), Mat3::Identity());
