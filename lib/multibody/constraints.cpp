@@ -159,6 +159,47 @@ class Revolute : public Constraint {
   std::vector<int> unknowns_;
 };
 
+// ---- rigid connection with an aligned (unit) director (§4.2; quadratic) ---------------------------------
+class AlignedConnection : public Constraint {
+ public:
+  AlignedConnection(std::string name, PointMap x, PointMap p, int body, const Vec3& X, const Vec3& b, const Vec3& c)
+      : Constraint(std::move(name), "rigid connection"), x_(x), y_(PointMap::body_point(body, X)), p_(p),
+        b_(PointMap::body_vector(body, b)), c_(PointMap::body_vector(body, c)),
+        unknowns_(unknowns_of({&x_, &y_, &p_, &b_, &c_})) {}
+  int size() const override { return 5; }
+  ConstraintKind kind() const override { return ConstraintKind::quadratic; }
+  std::vector<int> unknowns() const override { return unknowns_; }
+  Eigen::VectorXd g(const Eigen::VectorXd& q, double) const override {
+    Eigen::VectorXd r(5);
+    r.head<3>() = x_(q) - y_(q);
+    const Vec3 p = p_(q);
+    r(3) = p.dot(b_(q));
+    r(4) = p.dot(c_(q));
+    return r;
+  }
+  void jacobian(const Eigen::VectorXd& q, double, std::vector<Triplet>& out) const override {
+    x_.add_block(0, 1.0, out);
+    y_.add_block(0, -1.0, out);
+    const Vec3 p = p_(q), b = b_(q), c = c_(q);
+    p_.add_row(3, b, 1.0, out);
+    b_.add_row(3, p, 1.0, out);
+    p_.add_row(4, c, 1.0, out);
+    c_.add_row(4, p, 1.0, out);
+  }
+  void hessian_contraction(const Eigen::VectorXd&, double, const Eigen::VectorXd& lam,
+                           std::vector<Triplet>& out) const override {
+    const Eigen::Matrix3d I = Eigen::Matrix3d::Identity();
+    p_.add_outer(b_, I, lam(3), out);
+    b_.add_outer(p_, I, lam(3), out);
+    p_.add_outer(c_, I, lam(4), out);
+    c_.add_outer(p_, I, lam(4), out);
+  }
+
+ private:
+  PointMap x_, y_, p_, b_, c_;
+  std::vector<int> unknowns_;
+};
+
 // ---- orthonormality of a rigid body's directors (§3; quadratic) ----------------------------------------
 class Orthonormality : public Constraint {
  public:
@@ -461,7 +502,20 @@ std::unique_ptr<Constraint> revolute_joint(std::string name, PointMap a, PointMa
 }
 
 std::unique_ptr<Constraint> rigid_connection(std::string name, PointMap x, PointMap p, int body_base,
-                                             const Vec3& X, const Vec3& a) {
+                                             const Vec3& X, const Vec3& a, DirectorCondition form) {
+  if (form == DirectorCondition::aligned) {
+    if (!(std::abs(a.norm() - 1.0) < 1e-12)) {
+      std::ostringstream os;
+      os << "rigid connection '" << name << "': the director's body components (" << a.transpose()
+         << ") must form a unit vector for the aligned form";
+      throw std::invalid_argument(os.str());
+    }
+    // (a, b, c) orthonormal: b from the body axis least aligned with a.
+    Eigen::Index k;
+    a.cwiseAbs().minCoeff(&k);
+    const Vec3 b = a.cross(Vec3::Unit(k)).normalized(), c = a.cross(b);
+    return std::make_unique<AlignedConnection>(std::move(name), x, p, body_base, X, b, c);
+  }
   return std::make_unique<Coincidence>(
       std::move(name), "rigid connection",
       std::vector<std::pair<PointMap, PointMap>>{{x, PointMap::body_point(body_base, X)},

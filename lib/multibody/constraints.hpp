@@ -104,10 +104,16 @@ std::unique_ptr<Constraint> fixed_point(std::string name, PointMap a, const Vec3
 std::unique_ptr<Constraint> revolute_joint(std::string name, PointMap a, PointMap b, PointMap axis_a,
                                            PointMap normal1_b, PointMap normal2_b);
 
-// Rigid connection of a node to a rigid body (§4.2): x_node = φ + Σ X_k d_k and p_node = Σ a_k d_k with X, a
-// the node's position and director in the body frame at assembly. Linear, 6 rows.
+// Rigid connection of a node to a rigid body (§4.2): x_node = φ + Σ X_k d_k, with X the node's position in the
+// body frame at assembly, and a director condition:
+//   equal:   p_node = Σ a_k d_k (3 linear rows) — for a director that is a free ℝ³ vector;
+//   aligned: p_node · Σ b_k d_k = 0 and p_node · Σ c_k d_k = 0 with (a, b, c) orthonormal (2 quadratic rows) —
+//            for a director that is unit by construction (a shell director through its chart, a body axis),
+//            where the third row of `equal` would repeat the unit length and make G rank deficient.
+enum class DirectorCondition { equal, aligned };
 std::unique_ptr<Constraint> rigid_connection(std::string name, PointMap node_position, PointMap node_director,
-                                             int body_base, const Vec3& X, const Vec3& a);
+                                             int body_base, const Vec3& X, const Vec3& a,
+                                             DirectorCondition form = DirectorCondition::equal);
 
 // The six orthonormality conditions ½(d_i·d_j − δ_ij) of a rigid body at body_base (§3). Quadratic.
 std::unique_ptr<Constraint> orthonormality(std::string name, int body_base);

@@ -98,6 +98,8 @@ std::vector<std::unique_ptr<Constraint>> every_kind() {
                              PointMap::body_vector(kB2, Vec3(0, 0, 1))));
   c.push_back(rigid_connection("clamp", PointMap::node_position(kU, Vec3(1, 2, 0)), PointMap::vector3(kP), kB1,
                                Vec3(0.4, 0.1, -0.2), Vec3(0.6, 0.0, 0.8)));
+  c.push_back(rigid_connection("clamp-aligned", PointMap::body_point(kB2, X2), PointMap::body_vector(kB2, Vec3(0, 0, 1)),
+                               kB1, Vec3(0.4, 0.1, -0.2), Vec3(0.6, 0.0, 0.8), DirectorCondition::aligned));
   c.push_back(orthonormality("frame", kB2));
   c.push_back(distance("link", PointMap::body_point(kB1, X1), PointMap::node_position(kU, Vec3(1, 2, 0)), 1.3));
   c.push_back(distance("link-gonzalez", PointMap::body_point(kB2, X2), PointMap::vector3(kP), 0.9,
@@ -228,7 +230,7 @@ TEST(Constraints, StackedSetMatchesTheKindsRowByRow) {
   const Eigen::SparseMatrix<double> Gb = set.Gbar(q0, 0.1, q1, 0.2, tau);
   EXPECT_EQ(Gb.rows(), set.rows());
   EXPECT_LT((Gb * (q1 - q0) + tau - (set.g(q1, 0.2) - set.g(q0, 0.1))).norm(), 1e-13);
-  EXPECT_EQ(set.rows(), 3 + 3 + 3 + 5 + 5 + 6 + 6 + 1 + 1 + 6);
+  EXPECT_EQ(set.rows(), 3 + 3 + 3 + 5 + 5 + 6 + 5 + 6 + 1 + 1 + 6);
 }
 
 TEST(Constraints, BadReferencesAndDuplicateNamesAreRefused) {
