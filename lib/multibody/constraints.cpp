@@ -14,9 +14,15 @@
 namespace shelldyn::multibody {
 
 // ---- PointMap ------------------------------------------------------------------------------------------
-PointMap PointMap::ground(const Vec3& x) { return PointMap{x, {}}; }
-PointMap PointMap::node_position(int base, const Vec3& X) { return PointMap{X, {{base, 1.0}}}; }
-PointMap PointMap::vector3(int base) { return PointMap{Vec3::Zero(), {{base, 1.0}}}; }
+PointMap PointMap::ground(const Vec3& x) {
+  return PointMap{x, {}};
+}
+PointMap PointMap::node_position(int base, const Vec3& X) {
+  return PointMap{X, {{base, 1.0}}};
+}
+PointMap PointMap::vector3(int base) {
+  return PointMap{Vec3::Zero(), {{base, 1.0}}};
+}
 PointMap PointMap::body_point(int b, const Vec3& X) {
   return PointMap{Vec3::Zero(), {{b, 1.0}, {b + 3, X(0)}, {b + 6, X(1)}, {b + 9, X(2)}}};
 }
@@ -48,7 +54,8 @@ void PointMap::add_block(int row0, double scale, std::vector<Triplet>& out) cons
       if (c != 0.0) out.emplace_back(row0 + k, b + k, scale * c);
 }
 
-void PointMap::add_outer(const PointMap& y, const Eigen::Matrix3d& K, double scale, std::vector<Triplet>& out) const {
+void PointMap::add_outer(const PointMap& y, const Eigen::Matrix3d& K, double scale,
+                         std::vector<Triplet>& out) const {
   for (const auto& [bx, cx] : terms)
     for (const auto& [by, cy] : y.terms) {
       const double c = scale * cx * cy;
@@ -119,12 +126,18 @@ class Coincidence : public Constraint {
 class Revolute : public Constraint {
  public:
   Revolute(std::string name, PointMap a, PointMap b, PointMap e, PointMap f, PointMap h)
-      : Constraint(std::move(name), "revolute joint"), a_(a), b_(b), e_(e), f_(f), h_(h),
+      : Constraint(std::move(name), "revolute joint"),
+        a_(a),
+        b_(b),
+        e_(e),
+        f_(f),
+        h_(h),
         unknowns_(unknowns_of({&a_, &b_, &e_, &f_, &h_})) {}
   int size() const override { return 5; }
   // To the ground (a constant axis or constant normals) the axis rows are linear in q.
   ConstraintKind kind() const override {
-    return e_.constant() || (f_.constant() && h_.constant()) ? ConstraintKind::linear : ConstraintKind::quadratic;
+    return e_.constant() || (f_.constant() && h_.constant()) ? ConstraintKind::linear
+                                                             : ConstraintKind::quadratic;
   }
   std::vector<int> unknowns() const override { return unknowns_; }
   Eigen::VectorXd g(const Eigen::VectorXd& q, double) const override {
@@ -162,9 +175,14 @@ class Revolute : public Constraint {
 // ---- rigid connection with an aligned (unit) director (§4.2; quadratic) ---------------------------------
 class AlignedConnection : public Constraint {
  public:
-  AlignedConnection(std::string name, PointMap x, PointMap p, int body, const Vec3& X, const Vec3& b, const Vec3& c)
-      : Constraint(std::move(name), "rigid connection"), x_(x), y_(PointMap::body_point(body, X)), p_(p),
-        b_(PointMap::body_vector(body, b)), c_(PointMap::body_vector(body, c)),
+  AlignedConnection(std::string name, PointMap x, PointMap p, int body, const Vec3& X, const Vec3& b,
+                    const Vec3& c)
+      : Constraint(std::move(name), "rigid connection"),
+        x_(x),
+        y_(PointMap::body_point(body, X)),
+        p_(p),
+        b_(PointMap::body_vector(body, b)),
+        c_(PointMap::body_vector(body, c)),
         unknowns_(unknowns_of({&x_, &y_, &p_, &b_, &c_})) {}
   int size() const override { return 5; }
   ConstraintKind kind() const override { return ConstraintKind::quadratic; }
@@ -253,7 +271,11 @@ class Orthonormality : public Constraint {
 class Distance : public Constraint {
  public:
   Distance(std::string name, PointMap a, PointMap b, double L, DistanceGradient form)
-      : Constraint(std::move(name), "distance"), a_(a), b_(b), L_(L), form_(form),
+      : Constraint(std::move(name), "distance"),
+        a_(a),
+        b_(b),
+        L_(L),
+        form_(form),
         unknowns_(unknowns_of({&a_, &b_})) {}
   int size() const override { return 1; }
   ConstraintKind kind() const override { return ConstraintKind::general; }
@@ -325,8 +347,12 @@ class PrescribedRotation : public Constraint {
  public:
   PrescribedRotation(std::string name, int base, const Vec3& Xp, const Vec3& a, const Vec3& u, const Vec3& c,
                      const Vec3& n, const Vec3& u0, AngleHistory th)
-      : Constraint(std::move(name), "prescribed rotation"), pivot_(PointMap::body_point(base, Xp)),
-        axis_(PointMap::body_vector(base, a)), radial_(PointMap::body_vector(base, u)), c_(c), n_(n),
+      : Constraint(std::move(name), "prescribed rotation"),
+        pivot_(PointMap::body_point(base, Xp)),
+        axis_(PointMap::body_vector(base, a)),
+        radial_(PointMap::body_vector(base, u)),
+        c_(c),
+        n_(n),
         th_(std::move(th)) {
     // t1, t2 ⟂ n: the axis rows a_hub · t_k = 0; w0 = n × u0: the drive row's direction at θ = 0.
     t1_ = u0;
@@ -383,7 +409,8 @@ class PrescribedRotation : public Constraint {
 void require_unit(const std::string& name, const char* what, const Vec3& v) {
   if (!(std::abs(v.norm() - 1.0) < 1e-12)) {
     std::ostringstream os;
-    os << "prescribed rotation '" << name << "': " << what << " (" << v.transpose() << ") must be a unit vector";
+    os << "prescribed rotation '" << name << "': " << what << " (" << v.transpose()
+       << ") must be a unit vector";
     throw std::invalid_argument(os.str());
   }
 }
@@ -391,7 +418,9 @@ void require_unit(const std::string& name, const char* what, const Vec3& v) {
 }  // namespace
 
 // ---- Constraint defaults --------------------------------------------------------------------------------
-Eigen::VectorXd Constraint::dg_dt(const Eigen::VectorXd&, double) const { return Eigen::VectorXd::Zero(size()); }
+Eigen::VectorXd Constraint::dg_dt(const Eigen::VectorXd&, double) const {
+  return Eigen::VectorXd::Zero(size());
+}
 
 void Constraint::discrete_gradient(const Eigen::VectorXd& q0, double t0, const Eigen::VectorXd& q1, double t1,
                                    std::vector<Triplet>& out, Eigen::VectorXd& tau) const {
@@ -441,7 +470,8 @@ void Constraint::hessian_contraction(const Eigen::VectorXd& q, double t, const E
   if (kind() == ConstraintKind::linear) return;
   if (kind() == ConstraintKind::quadratic)
     throw std::logic_error("constraint '" + name() + "' (" + type() + ") must define its Hessian");
-  fd_tangent(*this, q, lam, [&](const Eigen::VectorXd& x, std::vector<Triplet>& t_) { jacobian(x, t, t_); }, out);
+  fd_tangent(
+      *this, q, lam, [&](const Eigen::VectorXd& x, std::vector<Triplet>& t_) { jacobian(x, t, t_); }, out);
 }
 
 void Constraint::discrete_tangent(const Eigen::VectorXd& q0, double t0, const Eigen::VectorXd& q1, double t1,
@@ -454,12 +484,13 @@ void Constraint::discrete_tangent(const Eigen::VectorXd& q0, double t0, const Ei
     for (const auto& e : h) out.emplace_back(e.row(), e.col(), 0.5 * e.value());
     return;
   }
-  fd_tangent(*this, q1, lam,
-             [&](const Eigen::VectorXd& x, std::vector<Triplet>& t_) {
-               Eigen::VectorXd tau;
-               discrete_gradient(q0, t0, x, t1, t_, tau);
-             },
-             out);
+  fd_tangent(
+      *this, q1, lam,
+      [&](const Eigen::VectorXd& x, std::vector<Triplet>& t_) {
+        Eigen::VectorXd tau;
+        discrete_gradient(q0, t0, x, t1, t_, tau);
+      },
+      out);
 }
 
 void gonzalez_discrete_gradient(const Constraint& c, const Eigen::VectorXd& q0, const Eigen::VectorXd& q1,
@@ -547,7 +578,8 @@ std::unique_ptr<Constraint> prescribed_rotation(std::string name, int hub_base, 
     throw std::invalid_argument("prescribed rotation '" + name +
                                 "': the radial vectors must be normal to their axes (hub and ground)");
   if (!angle.theta || !angle.theta_dot)
-    throw std::invalid_argument("prescribed rotation '" + name + "': the angle history θ(t), θ̇(t) is missing");
+    throw std::invalid_argument("prescribed rotation '" + name +
+                                "': the angle history θ(t), θ̇(t) is missing");
   return std::make_unique<PrescribedRotation>(std::move(name), hub_base, X_pivot, a_hub, u_hub, c, n, u0,
                                               std::move(angle));
 }
@@ -557,8 +589,8 @@ void ConstraintSet::add(std::unique_ptr<Constraint> c) {
   if (!c) throw std::invalid_argument("ConstraintSet::add: null constraint");
   for (const auto& o : list_)
     if (o->name() == c->name())
-      throw std::invalid_argument("constraint '" + c->name() + "': the name is already used by a " + o->type() +
-                                  "; give each constraint its own name");
+      throw std::invalid_argument("constraint '" + c->name() + "': the name is already used by a " +
+                                  o->type() + "; give each constraint its own name");
   const auto u = c->unknowns();
   if (!u.empty() && (u.front() < 0 || u.back() >= n_)) {
     std::ostringstream os;
@@ -604,8 +636,9 @@ Eigen::SparseMatrix<double> ConstraintSet::G(const Eigen::VectorXd& q, double t)
   return assemble(rows_, n_, all);
 }
 
-Eigen::SparseMatrix<double> ConstraintSet::Gbar(const Eigen::VectorXd& q0, double t0, const Eigen::VectorXd& q1,
-                                                double t1, Eigen::VectorXd& tau) const {
+Eigen::SparseMatrix<double> ConstraintSet::Gbar(const Eigen::VectorXd& q0, double t0,
+                                                const Eigen::VectorXd& q1, double t1,
+                                                Eigen::VectorXd& tau) const {
   std::vector<Triplet> all, local;
   tau.resize(rows_);
   Eigen::VectorXd tl;
@@ -676,8 +709,9 @@ RankReport ConstraintSet::rank_check(const Eigen::VectorXd& q, double t, double 
       if (Y.col(j).segment(offsets_[i], list_[i]->size()).norm() > 1e-6) in[i] = true;
   }
   std::ostringstream os;
-  os << (rep.conflicting ? "conflicting" : "redundant") << " constraints: the " << rows_ << " constraint rows have rank "
-     << rank << " (" << rows_ - rank << " dependent) at t = " << t << "; the dependent rows involve";
+  os << (rep.conflicting ? "conflicting" : "redundant") << " constraints: the " << rows_
+     << " constraint rows have rank " << rank << " (" << rows_ - rank << " dependent) at t = " << t
+     << "; the dependent rows involve";
   bool first = true;
   for (size_t i = 0; i < list_.size(); ++i)
     if (in[i]) {

@@ -1,4 +1,4 @@
-// Holonomic constraints on the global unknowns, with their discrete gradients (docs/theory/multibody.md §2, §4).
+// Holonomic constraints and their discrete gradients (docs/theory/multibody.md §2, §4).
 //
 // Every kind acts on "points": affine maps x(q) = x0 + Σ_j c_j q[b_j .. b_j+2] of the global unknown vector,
 // so the same joint serves a shell node (position X + u, ℝ³ director p), a rigid body in director form
@@ -7,8 +7,8 @@
 // Each constraint gives g(q, t) (size() rows), its Jacobian G = ∂g/∂q as sparse rows over the global columns
 // it touches, ∂g/∂t (zero unless rheonomic) and a discrete gradient Ḡ(q_n, q_{n+1}) with
 //     Ḡ Δq + τ = g(q_{n+1}, t_{n+1}) − g(q_n, t_n)        exactly (to round-off),                  (§2.2)
-// where τ (the "time part", zero for a scleronomic constraint) is the discrete ∂g/∂t Δt whose product with the
-// multipliers is the driver's work. Linear g: Ḡ = G; quadratic g: Ḡ = G(q_mid); general g: Gonzalez's
+// where τ (the "time part", zero for a scleronomic constraint) is the discrete ∂g/∂t Δt whose product with
+// the multipliers is the driver's work. Linear g: Ḡ = G; quadratic g: Ḡ = G(q_mid); general g: Gonzalez's
 // midpoint formula (§2.3) or a constraint-specific form.
 #pragma once
 
@@ -31,7 +31,7 @@ struct PointMap {
   std::vector<std::pair<int, double>> terms;  // (first index of a 3-block of q, coefficient)
 
   static PointMap ground(const Vec3& x);
-  static PointMap node_position(int base, const Vec3& X);   // X + u (u = translations of a node)
+  static PointMap node_position(int base, const Vec3& X);    // X + u (u = translations of a node)
   static PointMap vector3(int base);                         // an ℝ³ vector of the unknowns (a director p)
   static PointMap body_point(int body_base, const Vec3& X);  // φ + Σ X_k d_k of a rigid body at body_base
   static PointMap body_vector(int body_base, const Vec3& a);  // Σ a_k d_k
@@ -98,16 +98,16 @@ void gonzalez_discrete_gradient(const Constraint& c, const Eigen::VectorXd& q0, 
 std::unique_ptr<Constraint> spherical_joint(std::string name, PointMap a, PointMap b);
 std::unique_ptr<Constraint> fixed_point(std::string name, PointMap a, const Vec3& x0);
 
-// Revolute joint (§4.3): spherical joint a = b plus e_A · f_B = 0 and e_A · h_B = 0, where e_A is the hinge axis
-// in the first body and f_B, h_B span the plane normal to the axis in the second (vector maps, e.g.
+// Revolute joint (§4.3): spherical joint a = b plus e_A · f_B = 0 and e_A · h_B = 0, where e_A is the hinge
+// axis in the first body and f_B, h_B span the plane normal to the axis in the second (vector maps, e.g.
 // PointMap::body_vector; a constant map for the ground). Quadratic, 5 rows.
 std::unique_ptr<Constraint> revolute_joint(std::string name, PointMap a, PointMap b, PointMap axis_a,
                                            PointMap normal1_b, PointMap normal2_b);
 
-// Rigid connection of a node to a rigid body (§4.2): x_node = φ + Σ X_k d_k, with X the node's position in the
-// body frame at assembly, and a director condition:
+// Rigid connection of a node to a rigid body (§4.2): x_node = φ + Σ X_k d_k, with X the node's position in
+// the body frame at assembly, and a director condition:
 //   equal:   p_node = Σ a_k d_k (3 linear rows) — for a director that is a free ℝ³ vector;
-//   aligned: p_node · Σ b_k d_k = 0 and p_node · Σ c_k d_k = 0 with (a, b, c) orthonormal (2 quadratic rows) —
+//   aligned: p_node · Σ b_k d_k = 0 and p_node · Σ c_k d_k = 0, (a, b, c) orthonormal (2 quadratic rows),
 //            for a director that is unit by construction (a shell director through its chart, a body axis),
 //            where the third row of `equal` would repeat the unit length and make G rank deficient.
 enum class DirectorCondition { equal, aligned };
@@ -119,16 +119,16 @@ std::unique_ptr<Constraint> rigid_connection(std::string name, PointMap node_pos
 std::unique_ptr<Constraint> orthonormality(std::string name, int body_base);
 
 // Distance |a − b| − L = 0 between two points (a massless link). General (not polynomial). Its discrete
-// gradient is either the invariant form (§2.3: through π = |a − b|², Ḡ = 2 r_midᵀ ∂r/∂q / (|r0| + |r1|), which
-// keeps the momenta of a link between bodies) or Gonzalez's generic formula.
+// gradient is either the invariant form (§2.3: through π = |a − b|², Ḡ = 2 r_midᵀ ∂r/∂q / (|r0| + |r1|),
+// which keeps the momenta of a link between bodies) or Gonzalez's generic formula.
 enum class DistanceGradient { invariant, gonzalez };
 std::unique_ptr<Constraint> distance(std::string name, PointMap a, PointMap b, double length,
                                      DistanceGradient form = DistanceGradient::invariant);
 
-// Prescribed rotation of a rigid hub about a ground axis (§4.4; rheonomic): the hub's body point X_pivot is at
-// the ground point c, its body axis a_hub (unit) is along the unit ground axis n, and its body vector u_hub
-// (unit, normal to a_hub) follows R(θ(t), n) u0, where u0 ⟂ n is its ground direction at θ = 0. The drive
-// row u_hub · R(θ(t), n)(n × u0) = 0 is linear in q at fixed t; 6 rows in all.
+// Prescribed rotation of a rigid hub about a ground axis (§4.4; rheonomic): the hub's body point X_pivot is
+// at the ground point c, its body axis a_hub (unit) is along the unit ground axis n, and its body vector
+// u_hub (unit, normal to a_hub) follows R(θ(t), n) u0, where u0 ⟂ n is its ground direction at θ = 0. The
+// drive row u_hub · R(θ(t), n)(n × u0) = 0 is linear in q at fixed t; 6 rows in all.
 struct AngleHistory {
   std::function<double(double)> theta, theta_dot;
 };
@@ -165,13 +165,14 @@ class ConstraintSet {
   // The stacked tangents of §5.1 for the stacked multipliers lambda (rows() entries); n × n.
   Eigen::SparseMatrix<double> hessian_contraction(const Eigen::VectorXd& q, double t,
                                                   const Eigen::VectorXd& lambda) const;
-  Eigen::SparseMatrix<double> discrete_tangent(const Eigen::VectorXd& q0, double t0, const Eigen::VectorXd& q1,
-                                               double t1, const Eigen::VectorXd& lambda) const;
+  Eigen::SparseMatrix<double> discrete_tangent(const Eigen::VectorXd& q0, double t0,
+                                               const Eigen::VectorXd& q1, double t1,
+                                               const Eigen::VectorXd& lambda) const;
 
-  // Row rank of G(q, t) by an SVD over the touched columns (§2.5): singular values ≤ tol · max(1, σ_max) count
-  // as zero; the left null vectors name the constraints involved, and |yᵀ g(q, t)| > g_tol marks a conflict.
-  // `fixed` (empty, or one flag per unknown) drops the unknowns a support already prescribes: a joint acting
-  // only on such unknowns, or fixing again what a support fixes, is then reported as well.
+  // Row rank of G(q, t) by an SVD over the touched columns (§2.5): singular values ≤ tol · max(1, σ_max)
+  // count as zero; the left null vectors name the constraints involved, and |yᵀ g(q, t)| > g_tol marks a
+  // conflict. `fixed` (empty, or one flag per unknown) drops the unknowns a support already prescribes: a
+  // joint acting only on such unknowns, or fixing again what a support fixes, is then reported as well.
   RankReport rank_check(const Eigen::VectorXd& q, double t, double tol = 1e-10, double g_tol = 1e-9,
                         const std::vector<bool>& fixed = {}) const;
   // Throws std::invalid_argument with RankReport::message if G is rank deficient.

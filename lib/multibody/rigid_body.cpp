@@ -13,7 +13,8 @@ namespace {
 constexpr int kPairs[6][2] = {{0, 0}, {1, 1}, {2, 2}, {0, 1}, {0, 2}, {1, 2}};
 }  // namespace
 
-RigidBody::RigidBody(std::string name, double mass, const Vec3& J) : name_(std::move(name)), mass_(mass), J_(J) {
+RigidBody::RigidBody(std::string name, double mass, const Vec3& J)
+    : name_(std::move(name)), mass_(mass), J_(J) {
   auto fail = [&](const std::string& why) {
     throw std::invalid_argument("rigid body '" + name_ + "': " + why);
   };
@@ -42,7 +43,9 @@ RigidBody::RigidBody(std::string name, double mass, const Vec3& J) : name_(std::
   }
 }
 
-Mat12 RigidBody::mass_matrix() const { return mass_diagonal().asDiagonal(); }
+Mat12 RigidBody::mass_matrix() const {
+  return mass_diagonal().asDiagonal();
+}
 
 Vec12 RigidBody::mass_diagonal() const {
   Vec12 m;
@@ -71,7 +74,9 @@ double RigidBody::kinetic_energy(const Vec12& v) const {
   return 0.5 * T;
 }
 
-Vec3 RigidBody::linear_momentum(const Vec12& v) const { return mass_ * v.segment<3>(0); }
+Vec3 RigidBody::linear_momentum(const Vec12& v) const {
+  return mass_ * v.segment<3>(0);
+}
 
 Vec3 RigidBody::angular_momentum(const Vec12& q, const Vec12& v) const {
   Vec3 J = mass_ * Vec3(q.segment<3>(0)).cross(Vec3(v.segment<3>(0)));
@@ -79,7 +84,9 @@ Vec3 RigidBody::angular_momentum(const Vec12& q, const Vec12& v) const {
   return J;
 }
 
-Vec3 RigidBody::point(const Vec12& q, const Vec3& X) { return q.segment<3>(0) + body_vector(q, X); }
+Vec3 RigidBody::point(const Vec12& q, const Vec3& X) {
+  return q.segment<3>(0) + body_vector(q, X);
+}
 
 Vec3 RigidBody::body_vector(const Vec12& q, const Vec3& a) {
   return a(0) * q.segment<3>(3) + a(1) * q.segment<3>(6) + a(2) * q.segment<3>(9);

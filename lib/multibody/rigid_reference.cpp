@@ -19,15 +19,18 @@ using Eigen::VectorXd;
 // Tableau of Dormand & Prince (1980), RK5(4)7M; the 5th-order solution propagates (local extrapolation) and
 // the last stage is the next step's first (FSAL). e = b − b̂ gives the embedded error estimate.
 std::vector<VectorXd> dormand_prince(const OdeRhs& f, double t0, const VectorXd& y0,
-                                     const std::vector<double>& outputs, const Rk45Options& opt, Rk45Stats* st) {
+                                     const std::vector<double>& outputs, const Rk45Options& opt,
+                                     Rk45Stats* st) {
   static constexpr double c2 = 1.0 / 5, c3 = 3.0 / 10, c4 = 4.0 / 5, c5 = 8.0 / 9;
   static constexpr double a21 = 1.0 / 5;
   static constexpr double a31 = 3.0 / 40, a32 = 9.0 / 40;
   static constexpr double a41 = 44.0 / 45, a42 = -56.0 / 15, a43 = 32.0 / 9;
-  static constexpr double a51 = 19372.0 / 6561, a52 = -25360.0 / 2187, a53 = 64448.0 / 6561, a54 = -212.0 / 729;
+  static constexpr double a51 = 19372.0 / 6561, a52 = -25360.0 / 2187, a53 = 64448.0 / 6561,
+                          a54 = -212.0 / 729;
   static constexpr double a61 = 9017.0 / 3168, a62 = -355.0 / 33, a63 = 46732.0 / 5247, a64 = 49.0 / 176,
                           a65 = -5103.0 / 18656;
-  static constexpr double b1 = 35.0 / 384, b3 = 500.0 / 1113, b4 = 125.0 / 192, b5 = -2187.0 / 6784, b6 = 11.0 / 84;
+  static constexpr double b1 = 35.0 / 384, b3 = 500.0 / 1113, b4 = 125.0 / 192, b5 = -2187.0 / 6784,
+                          b6 = 11.0 / 84;
   static constexpr double e1 = 71.0 / 57600, e3 = -71.0 / 16695, e4 = 71.0 / 1920, e5 = -17253.0 / 339200,
                           e6 = 22.0 / 525, e7 = -1.0 / 40;
   Rk45Stats local;
@@ -56,7 +59,8 @@ std::vector<VectorXd> dormand_prince(const OdeRhs& f, double t0, const VectorXd&
     if (tout < t) throw std::invalid_argument("dormand_prince: output times must be increasing and >= t0");
     while (t < tout) {
       if (s.accepted + s.rejected >= opt.max_steps)
-        throw std::runtime_error("dormand_prince: more than max_steps steps (raise max_steps or loosen rtol)");
+        throw std::runtime_error(
+            "dormand_prince: more than max_steps steps (raise max_steps or loosen rtol)");
       bool last = false;
       double hs = h;
       if (t + hs >= tout) {
@@ -87,8 +91,10 @@ std::vector<VectorXd> dormand_prince(const OdeRhs& f, double t0, const VectorXd&
         y = yn;
         k1 = k7;
         ++s.accepted;
-        if (!last) h = hs * fac;  // a shortened last step does not shrink the next one
-        else h = std::max(h, hs * fac);
+        if (!last)
+          h = hs * fac;  // a shortened last step does not shrink the next one
+        else
+          h = std::max(h, hs * fac);
       } else {
         ++s.rejected;
         h = hs * std::min(1.0, fac);
@@ -108,16 +114,16 @@ Matrix3d hat(const Vector3d& w) {
 }
 }  // namespace
 
-SphericalChainReference::SphericalChainReference(std::vector<ReferenceBody> bodies, std::vector<ReferenceJoint> joints,
-                                                 const Vector3d& gravity)
+SphericalChainReference::SphericalChainReference(std::vector<ReferenceBody> bodies,
+                                                 std::vector<ReferenceJoint> joints, const Vector3d& gravity)
     : bodies_(std::move(bodies)), joints_(std::move(joints)), gravity_(gravity) {
   const int nb = num_bodies();
   for (size_t j = 0; j < joints_.size(); ++j) {
     const auto& jt = joints_[j];
     if (jt.a < 0 || jt.a >= nb || jt.b < -1 || jt.b >= nb || jt.a == jt.b) {
       std::ostringstream os;
-      os << "SphericalChainReference: joint " << j << " connects body " << jt.a << " to " << jt.b << " but there are "
-         << nb << " bodies (use −1 for the ground, and two different bodies)";
+      os << "SphericalChainReference: joint " << j << " connects body " << jt.a << " to " << jt.b
+         << " but there are " << nb << " bodies (use −1 for the ground, and two different bodies)";
       throw std::invalid_argument(os.str());
     }
   }
@@ -126,12 +132,18 @@ SphericalChainReference::SphericalChainReference(std::vector<ReferenceBody> bodi
       throw std::invalid_argument("SphericalChainReference: every body needs a positive mass and inertias");
 }
 
-Vector3d SphericalChainReference::position(const VectorXd& y, int i) { return y.segment<3>(kPerBody * i); }
-Vector3d SphericalChainReference::velocity(const VectorXd& y, int i) { return y.segment<3>(kPerBody * i + 3); }
+Vector3d SphericalChainReference::position(const VectorXd& y, int i) {
+  return y.segment<3>(kPerBody * i);
+}
+Vector3d SphericalChainReference::velocity(const VectorXd& y, int i) {
+  return y.segment<3>(kPerBody * i + 3);
+}
 Matrix3d SphericalChainReference::rotation(const VectorXd& y, int i) {
   return Eigen::Map<const Matrix3d>(y.data() + kPerBody * i + 6);
 }
-Vector3d SphericalChainReference::omega_body(const VectorXd& y, int i) { return y.segment<3>(kPerBody * i + 15); }
+Vector3d SphericalChainReference::omega_body(const VectorXd& y, int i) {
+  return y.segment<3>(kPerBody * i + 15);
+}
 
 VectorXd SphericalChainReference::initial_state() const {
   VectorXd y(kPerBody * num_bodies());
@@ -227,8 +239,7 @@ Vector3d SphericalChainReference::angular_momentum(const VectorXd& y) const {
   Vector3d J = Vector3d::Zero();
   for (int i = 0; i < num_bodies(); ++i) {
     const auto& b = bodies_[i];
-    J += b.mass * position(y, i).cross(velocity(y, i)) +
-         rotation(y, i) * b.J.cwiseProduct(omega_body(y, i));
+    J += b.mass * position(y, i).cross(velocity(y, i)) + rotation(y, i) * b.J.cwiseProduct(omega_body(y, i));
   }
   return J;
 }

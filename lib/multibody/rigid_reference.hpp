@@ -35,13 +35,14 @@ struct ReferenceBody {
   double mass = 1.0;
   Eigen::Vector3d J = Eigen::Vector3d::Ones();  // principal inertias about the centre of mass
   Eigen::Matrix3d R = Eigen::Matrix3d::Identity();
-  Eigen::Vector3d x = Eigen::Vector3d::Zero(), v = Eigen::Vector3d::Zero(), omega_body = Eigen::Vector3d::Zero();
+  Eigen::Vector3d x = Eigen::Vector3d::Zero(), v = Eigen::Vector3d::Zero(),
+                  omega_body = Eigen::Vector3d::Zero();
 };
 struct ReferenceJoint {
-  int a = 0;                                         // body index
-  Eigen::Vector3d ra = Eigen::Vector3d::Zero();      // joint point in a's body frame (from its centre of mass)
-  int b = -1;                                        // body index, −1 for the ground
-  Eigen::Vector3d rb = Eigen::Vector3d::Zero();      // in b's body frame, or the ground point
+  int a = 0;                                     // body index
+  Eigen::Vector3d ra = Eigen::Vector3d::Zero();  // joint point in a's body frame (from its centre of mass)
+  int b = -1;                                    // body index, −1 for the ground
+  Eigen::Vector3d rb = Eigen::Vector3d::Zero();  // in b's body frame, or the ground point
 };
 
 class SphericalChainReference {
@@ -62,7 +63,7 @@ class SphericalChainReference {
   double energy(const Eigen::VectorXd& y) const;  // kinetic − m g·x
   Eigen::Vector3d linear_momentum(const Eigen::VectorXd& y) const;
   Eigen::Vector3d angular_momentum(const Eigen::VectorXd& y) const;  // about the origin
-  double joint_gap(const Eigen::VectorXd& y) const;                  // max over joints of |x_a + R_a r_a − (…)_b|
+  double joint_gap(const Eigen::VectorXd& y) const;  // max over joints of |x_a + R_a r_a − (…)_b|
 
  private:
   std::vector<ReferenceBody> bodies_;
@@ -72,7 +73,8 @@ class SphericalChainReference {
 
 // Compound pendulum about a fixed horizontal hinge, I_p the inertia about the hinge, l the distance from the
 // hinge to the centre of mass: the exact period at amplitude θ0, T = 4 K(sin(θ0/2)) √(I_p/(m g l)) with the
-// complete elliptic integral K(k) = π / (2 AGM(1, √(1 − k²))), and its small-amplitude limit 2π √(I_p/(m g l)).
+// complete elliptic integral K(k) = π / (2 AGM(1, √(1 − k²))), and its small-amplitude limit 2π √(I_p/(m g
+// l)).
 double compound_pendulum_period(double Ip, double m, double g, double l, double theta0);
 double compound_pendulum_small_period(double Ip, double m, double g, double l);
 

@@ -48,8 +48,9 @@ Vec3 DirectorSystem::angular_momentum(const Eigen::VectorXd& q, const Eigen::Vec
 
 namespace {
 // The constraint force term Bᵀμ with B = Ḡ(q0, q1) (or G(q1)) and the driver's τ.
-Eigen::VectorXd force_term(const DirectorSystem& s, const Eigen::VectorXd& q0, double t0, const Eigen::VectorXd& q1,
-                           double t1, const Eigen::VectorXd& mu, GradientChoice c, Eigen::VectorXd* tau) {
+Eigen::VectorXd force_term(const DirectorSystem& s, const Eigen::VectorXd& q0, double t0,
+                           const Eigen::VectorXd& q1, double t1, const Eigen::VectorXd& mu, GradientChoice c,
+                           Eigen::VectorXd* tau) {
   Eigen::VectorXd tl;
   const Eigen::SparseMatrix<double> B =
       c == GradientChoice::discrete ? s.constraints.Gbar(q0, t0, q1, t1, tl) : s.constraints.G(q1, t1);
@@ -58,8 +59,8 @@ Eigen::VectorXd force_term(const DirectorSystem& s, const Eigen::VectorXd& q0, d
 }
 }  // namespace
 
-StepResult step(const DirectorSystem& s, const Eigen::VectorXd& q0, const Eigen::VectorXd& v0, double t0, double dt,
-                GradientChoice choice) {
+StepResult step(const DirectorSystem& s, const Eigen::VectorXd& q0, const Eigen::VectorXd& v0, double t0,
+                double dt, GradientChoice choice) {
   const int n = s.n(), m = s.constraints.rows();
   const double t1 = t0 + dt;
   const Eigen::VectorXd M = s.mass_diagonal();

@@ -1,6 +1,7 @@
 // Test-only: a conserving step for rigid bodies in director form with holonomic constraints
 // (docs/theory/multibody.md §5). Constant mass matrix, uniform gravity, multipliers on the discrete gradient:
-//     (2/Δt) M (q1 − q0) − 2 M v0 + Δt ∇V + Ḡ(q0, q1)ᵀ μ = 0,      g(q1, t1) = 0,      v1 = 2(q1 − q0)/Δt − v0,
+//     (2/Δt) M (q1 − q0) − 2 M v0 + Δt ∇V + Ḡ(q0, q1)ᵀ μ = 0,      g(q1, t1) = 0,      v1 = 2(q1 − q0)/Δt −
+//     v0,
 // solved by Newton on the saddle-point system with a dense LU. With GradientChoice::endpoint Ḡ is replaced by
 // G(q1) (the non-conserving variant the tests use to show the discrete gradient matters).
 #pragma once
@@ -37,7 +38,7 @@ struct DirectorSystem {
 
 struct StepResult {
   Eigen::VectorXd q, v;
-  Eigen::VectorXd lambda;  // λ_{n+1/2} = μ/Δt, the constraint forces are −Ḡᵀλ
+  Eigen::VectorXd lambda;   // λ_{n+1/2} = μ/Δt, the constraint forces are −Ḡᵀλ
   double drive_work = 0.0;  // λ·τ, the driver's discrete work (§4.4)
   int iterations = 0;
 };

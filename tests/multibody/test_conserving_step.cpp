@@ -1,7 +1,8 @@
 // End-to-end check of the construction on rigid bodies (docs/theory/multibody.md §5, §8): the conserving
-// director-form step with multipliers on the discrete gradient keeps the energy to solver tolerance, the momenta
-// exactly where no ground joint breaks them, and g = 0 at every step end; its trajectory converges at second
-// order to the independent RK45 reference; replacing Ḡ by the end-point Jacobian G(q_{n+1}) loses the energy (§8).
+// director-form step with multipliers on the discrete gradient keeps the energy to solver tolerance, the
+// momenta exactly where no ground joint breaks them, and g = 0 at every step end; its trajectory converges at
+// second order to the independent RK45 reference; replacing Ḡ by the end-point Jacobian G(q_{n+1}) loses the
+// energy (§8).
 #include "director_step.hpp"
 #include "lib/multibody/rigid_reference.hpp"
 
@@ -15,11 +16,11 @@
 namespace shelldyn::multibody {
 namespace {
 
-using testing::DirectorSystem;
-using testing::GradientChoice;
 using Eigen::Matrix3d;
 using Eigen::Vector3d;
 using Eigen::VectorXd;
+using testing::DirectorSystem;
+using testing::GradientChoice;
 
 struct RunSummary {
   double max_dH = 0.0, max_dL = 0.0, max_dJ = 0.0, max_dJz = 0.0, max_g = 0.0, work = 0.0;
@@ -28,7 +29,8 @@ struct RunSummary {
   int steps = 0, iterations = 0;
 };
 
-RunSummary integrate(const DirectorSystem& s, VectorXd q, VectorXd v, double dt, int steps, GradientChoice c) {
+RunSummary integrate(const DirectorSystem& s, VectorXd q, VectorXd v, double dt, int steps,
+                     GradientChoice c) {
   RunSummary r;
   r.H0 = s.energy(q, v);
   const Vector3d L0 = s.linear_momentum(v), J0 = s.angular_momentum(q, v);
@@ -135,8 +137,9 @@ TEST(ConservingStep, HeavyTopKeepsEnergyAndVerticalMomentumAndTheConstraints) {
   const DirectorSystem s = top.system();
   ASSERT_TRUE(s.constraints.rank_check(top.q0(), 0.0).message.empty());
   const RunSummary r = integrate(s, top.q0(), top.v0(), 2e-3, 500, testing::default_choice());
-  std::printf("heavy top, 500 steps of 2e-3: max|H-H0|/H0 %.3e  max|dJz| %.3e  max|g| %.3e  Newton its/step %.2f\n",
-              r.max_dH / std::abs(r.H0), r.max_dJz, r.max_g, double(r.iterations) / r.steps);
+  std::printf(
+      "heavy top, 500 steps of 2e-3: max|H-H0|/H0 %.3e  max|dJz| %.3e  max|g| %.3e  Newton its/step %.2f\n",
+      r.max_dH / std::abs(r.H0), r.max_dJz, r.max_g, double(r.iterations) / r.steps);
   EXPECT_LT(r.max_dH / std::abs(r.H0), 1e-12);
   EXPECT_LT(r.max_dJz, 1e-12);  // gravity and the pivot at the origin exert no torque about the vertical
   EXPECT_LT(r.max_g, 1e-14);
@@ -148,8 +151,8 @@ TEST(ConservingStep, EndPointJacobianLosesTheEnergy) {
   const DirectorSystem s = top.system();
   const RunSummary d = integrate(s, top.q0(), top.v0(), 2e-3, 500, GradientChoice::discrete);
   const RunSummary e = integrate(s, top.q0(), top.v0(), 2e-3, 500, GradientChoice::endpoint);
-  std::printf("heavy top energy error: discrete gradient %.3e, end-point Jacobian %.3e\n", d.max_dH / std::abs(d.H0),
-              e.max_dH / std::abs(e.H0));
+  std::printf("heavy top energy error: discrete gradient %.3e, end-point Jacobian %.3e\n",
+              d.max_dH / std::abs(d.H0), e.max_dH / std::abs(e.H0));
   EXPECT_LT(e.max_g, 1e-14);
   EXPECT_GT(e.max_dH / std::abs(e.H0), 1e4 * std::max(d.max_dH / std::abs(d.H0), 1e-15));
   EXPECT_GT(e.max_dH / std::abs(e.H0), 1e-8);
@@ -159,12 +162,12 @@ TEST(ConservingStep, HeavyTopConvergesAtSecondOrderToTheReference) {
   const Top top;
   const DirectorSystem s = top.system();
   const double T = 0.5;
-  const double e1 = trajectory_error(integrate(s, top.q0(), top.v0(), T / 250, 250, GradientChoice::discrete).q,
-                                     top.reference(), T);
-  const double e2 = trajectory_error(integrate(s, top.q0(), top.v0(), T / 500, 500, GradientChoice::discrete).q,
-                                     top.reference(), T);
-  std::printf("heavy top vs RK45 at t = %.1f: error %.3e (dt = %.0e), %.3e (dt = %.0e), ratio %.3f\n", T, e1, T / 250,
-              e2, T / 500, e1 / e2);
+  const double e1 = trajectory_error(
+      integrate(s, top.q0(), top.v0(), T / 250, 250, GradientChoice::discrete).q, top.reference(), T);
+  const double e2 = trajectory_error(
+      integrate(s, top.q0(), top.v0(), T / 500, 500, GradientChoice::discrete).q, top.reference(), T);
+  std::printf("heavy top vs RK45 at t = %.1f: error %.3e (dt = %.0e), %.3e (dt = %.0e), ratio %.3f\n", T, e1,
+              T / 250, e2, T / 500, e1 / e2);
   EXPECT_NEAR(e1 / e2, 4.0, 0.4);
   EXPECT_LT(e2, 1e-2);
 }
@@ -192,8 +195,8 @@ TEST(ConservingStep, FreeFlyingPairConvergesAtSecondOrderToTheReference) {
                                      p.reference(), T);
   const double e2 = trajectory_error(integrate(s, p.q0(), p.v0(), T / 400, 400, GradientChoice::discrete).q,
                                      p.reference(), T);
-  std::printf("free pair vs RK45 at t = %.1f: error %.3e (dt = %.1e), %.3e (dt = %.2e), ratio %.3f\n", T, e1, T / 200,
-              e2, T / 400, e1 / e2);
+  std::printf("free pair vs RK45 at t = %.1f: error %.3e (dt = %.1e), %.3e (dt = %.2e), ratio %.3f\n", T, e1,
+              T / 200, e2, T / 400, e1 / e2);
   EXPECT_NEAR(e1 / e2, 4.0, 0.4);
   EXPECT_LT(e2, 1e-2);
 }
@@ -220,8 +223,8 @@ TEST(ConservingStep, RodBetweenFreeBodiesKeepsEnergyAndMomentaInBothForms) {
     const RunSummary rs = integrate(s, q0, v, 5e-3, 400, GradientChoice::discrete);
     const double J = s.angular_momentum(q0, v).norm();
     std::printf("free pair with a rod, %s form: |dH|/H %.3e  |dJ|/|J| %.3e  max|g| %.3e\n",
-                form == DistanceGradient::invariant ? "invariant" : "Gonzalez", rs.max_dH / rs.H0, rs.max_dJ / J,
-                rs.max_g);
+                form == DistanceGradient::invariant ? "invariant" : "Gonzalez", rs.max_dH / rs.H0,
+                rs.max_dJ / J, rs.max_g);
     EXPECT_LT(rs.max_dH / rs.H0, 1e-12);
     EXPECT_LT(rs.max_g, 1e-14);
     return rs.max_dJ / J;
@@ -230,13 +233,14 @@ TEST(ConservingStep, RodBetweenFreeBodiesKeepsEnergyAndMomentaInBothForms) {
   EXPECT_LT(run(DistanceGradient::gonzalez), 1e-12);
 }
 
-// §4.2: a free-flying gyrostat — a rotor (body B) whose centre and axis d3 are clamped to a carrier (body A) by
-// a rigid connection with the aligned director form, so that B keeps its spin about the axis. Energy, L and J
-// stay exact. The equal form (3 rows on the unit axis d3) repeats the unit length that B's frame rows already
-// impose, and the rank check names both.
+// §4.2: a free-flying gyrostat — a rotor (body B) whose centre and axis d3 are clamped to a carrier (body A)
+// by a rigid connection with the aligned director form, so that B keeps its spin about the axis. Energy, L
+// and J stay exact. The equal form (3 rows on the unit axis d3) repeats the unit length that B's frame rows
+// already impose, and the rank check names both.
 TEST(ConservingStep, FreeGyrostatWithAnAlignedRigidConnection) {
   const double mA = 4.0, mB = 1.0;
-  const Vector3d JA(0.5, 0.7, 0.9), JB(0.05, 0.05, 0.08), X(0.3, -0.1, 0.2), a = Vector3d(1, 1, 2).normalized();
+  const Vector3d JA(0.5, 0.7, 0.9), JB(0.05, 0.05, 0.08), X(0.3, -0.1, 0.2),
+      a = Vector3d(1, 1, 2).normalized();
   const Matrix3d RA = Eigen::AngleAxisd(0.7, Vector3d(0.2, 1, 0.4).normalized()).toRotationMatrix();
   // B's d3 along the carrier's body vector a; its d1, d2 anywhere normal to it.
   Matrix3d Rb;
@@ -247,7 +251,8 @@ TEST(ConservingStep, FreeGyrostatWithAnAlignedRigidConnection) {
   const Vector3d wB = wA + 30.0 * Rb.col(2);  // the rotor spins at 30 rad/s relative to the carrier
   VectorXd q(24), v(24);
   q << RigidBody::state(xA, RA), RigidBody::state(xA + RA * X, Rb);
-  v << RigidBody::velocity(q.head<12>(), vA, wA), RigidBody::velocity(q.tail<12>(), vA + wA.cross(RA * X), wB);
+  v << RigidBody::velocity(q.head<12>(), vA, wA),
+      RigidBody::velocity(q.tail<12>(), vA + wA.cross(RA * X), wB);
   auto build = [&](DirectorCondition form) {
     DirectorSystem s({RigidBody("carrier", mA, JA), RigidBody("rotor", mB, JB)});
     s.constraints.add(orthonormality("carrier frame", 0));
@@ -267,9 +272,11 @@ TEST(ConservingStep, FreeGyrostatWithAnAlignedRigidConnection) {
   ASSERT_LT(s.constraints.g(q, 0.0).cwiseAbs().maxCoeff(), 1e-15);
   ASSERT_LT((s.constraints.G(q, 0.0) * v).cwiseAbs().maxCoeff(), 1e-13);
   const RunSummary rs = integrate(s, q, v, 2e-3, 500, testing::default_choice());
-  const double Lsc = mA * vA.norm() + mB * (vA + wA.cross(RA * X)).norm(), J = s.angular_momentum(q, v).norm();
-  std::printf("free gyrostat, 500 steps of 2e-3: |dH|/H %.3e  |dL|/(sum m|v|) %.3e  |dJ|/|J| %.3e  max|g| %.3e\n",
-              rs.max_dH / rs.H0, rs.max_dL / Lsc, rs.max_dJ / J, rs.max_g);
+  const double Lsc = mA * vA.norm() + mB * (vA + wA.cross(RA * X)).norm(),
+               J = s.angular_momentum(q, v).norm();
+  std::printf(
+      "free gyrostat, 500 steps of 2e-3: |dH|/H %.3e  |dL|/(sum m|v|) %.3e  |dJ|/|J| %.3e  max|g| %.3e\n",
+      rs.max_dH / rs.H0, rs.max_dL / Lsc, rs.max_dJ / J, rs.max_g);
   EXPECT_LT(rs.max_dH / rs.H0, 1e-12);
   // L is rebuilt from v = 2Δq/Δt − v_n: rounding of q (ε|q| ≈ 2e-16) over Δt = 2e-3, accumulated over 500
   // steps as a random walk, is ≈ 1e-12 of Σm|v| here; the bound allows that rounding, not a drift.
@@ -283,27 +290,29 @@ TEST(ConservingStep, FreeGyrostatWithAnAlignedRigidConnection) {
   EXPECT_NEAR(s1, s0, 1e-5 * std::abs(s0));  // measured 3.5e-6
 }
 
-// A hub driven about the vertical through θ(t) with a pendulum hanging from its rim: the energy changes by the
-// driver's discrete work λ·τ exactly (§4.4), and that work is not small.
+// A hub driven about the vertical through θ(t) with a pendulum hanging from its rim: the energy changes by
+// the driver's discrete work λ·τ exactly (§4.4), and that work is not small.
 TEST(ConservingStep, DrivenHubEnergyChangesByTheDriversWork) {
-  DirectorSystem s({RigidBody("hub", 5.0, Vector3d(1.0, 1.0, 1.5)), RigidBody("bob", 1.0, Vector3d(0.02, 0.02, 0.01))});
+  DirectorSystem s(
+      {RigidBody("hub", 5.0, Vector3d(1.0, 1.0, 1.5)), RigidBody("bob", 1.0, Vector3d(0.02, 0.02, 0.01))});
   s.gravity = Vector3d(0, 0, -9.81);
   const double alpha = 4.0;
   s.constraints.add(orthonormality("hub frame", 0));
   s.constraints.add(orthonormality("bob frame", 12));
-  s.constraints.add(prescribed_rotation("drive", 0, Vector3d::Zero(), Vector3d::UnitZ(), Vector3d::UnitX(),
-                                        Vector3d::Zero(), Vector3d::UnitZ(), Vector3d::UnitX(),
-                                        {[=](double t) { return 0.5 * alpha * t * t; },
-                                         [=](double t) { return alpha * t; }}));
+  s.constraints.add(prescribed_rotation(
+      "drive", 0, Vector3d::Zero(), Vector3d::UnitZ(), Vector3d::UnitX(), Vector3d::Zero(), Vector3d::UnitZ(),
+      Vector3d::UnitX(),
+      {[=](double t) { return 0.5 * alpha * t * t; }, [=](double t) { return alpha * t; }}));
   s.constraints.add(spherical_joint("rim", PointMap::body_point(0, Vector3d(0.6, 0, 0)),
                                     PointMap::body_point(12, Vector3d(0, 0, 0.3))));
   VectorXd q(24), v = VectorXd::Zero(24);
-  q << RigidBody::state(Vector3d::Zero(), Matrix3d::Identity()), RigidBody::state(Vector3d(0.6, 0, -0.3), Matrix3d::Identity());
+  q << RigidBody::state(Vector3d::Zero(), Matrix3d::Identity()),
+      RigidBody::state(Vector3d(0.6, 0, -0.3), Matrix3d::Identity());
   ASSERT_LT(s.constraints.g(q, 0.0).norm(), 1e-15);
   ASSERT_TRUE(s.constraints.rank_check(q, 0.0).message.empty());
   const RunSummary r = integrate(s, q, v, 2e-3, 500, testing::default_choice());
-  std::printf("driven hub, 500 steps of 2e-3: work %.6f, max|H - H0 - W| %.3e, max|g| %.3e\n", r.work, r.max_dH,
-              r.max_g);
+  std::printf("driven hub, 500 steps of 2e-3: work %.6f, max|H - H0 - W| %.3e, max|g| %.3e\n", r.work,
+              r.max_dH, r.max_g);
   EXPECT_GT(r.work, 1.0);
   EXPECT_LT(r.max_dH, 1e-11 * r.work);
   EXPECT_LT(r.max_g, 1e-14);
@@ -311,16 +320,17 @@ TEST(ConservingStep, DrivenHubEnergyChangesByTheDriversWork) {
   EXPECT_NEAR(std::atan2(r.q(4), r.q(3)), std::remainder(0.5 * alpha, 2 * M_PI), 1e-12);
 }
 
-// Compound pendulum on a revolute joint to the ground: the period of the director-form step against the closed
-// form T = 4K(sin(θ0/2))√(I_p/(m g l)); the error falls at second order in Δt.
+// Compound pendulum on a revolute joint to the ground: the period of the director-form step against the
+// closed form T = 4K(sin(θ0/2))√(I_p/(m g l)); the error falls at second order in Δt.
 TEST(ConservingStep, HingedPendulumHasTheClosedFormPeriod) {
   const double m = 2.0, l = 0.4, g = 9.81, th0 = 0.2;
   const Vector3d J(0.1, 0.15, 0.08);
   DirectorSystem s({RigidBody("plate", m, J)});
   s.gravity = Vector3d(0, 0, -g);
   s.constraints.add(orthonormality("plate frame", 0));
-  s.constraints.add(revolute_joint("hinge", PointMap::body_point(0, Vector3d(0, 0, l)), PointMap::ground(Vector3d::Zero()),
-                                   PointMap::ground(Vector3d::UnitY()), PointMap::body_vector(0, Vector3d::UnitX()),
+  s.constraints.add(revolute_joint("hinge", PointMap::body_point(0, Vector3d(0, 0, l)),
+                                   PointMap::ground(Vector3d::Zero()), PointMap::ground(Vector3d::UnitY()),
+                                   PointMap::body_vector(0, Vector3d::UnitX()),
                                    PointMap::body_vector(0, Vector3d::UnitZ())));
   const Matrix3d R0 = Eigen::AngleAxisd(th0, Vector3d::UnitY()).toRotationMatrix();
   const VectorXd q0 = RigidBody::state(-R0 * Vector3d(0, 0, l), R0), v0 = VectorXd::Zero(12);
@@ -343,9 +353,10 @@ TEST(ConservingStep, HingedPendulumHasTheClosedFormPeriod) {
     return down.size() >= 2 ? down[1] - down[0] : 0.0;
   };
   const double e1 = std::abs(measured_period(100) / T - 1), e2 = std::abs(measured_period(200) / T - 1);
-  std::printf("hinged pendulum, θ0 = %.1f: closed-form period %.9f s (small-amplitude %.9f s); relative error %.3e "
-              "(T/100), %.3e (T/200), ratio %.3f\n",
-              th0, T, compound_pendulum_small_period(Ip, m, g, l), e1, e2, e1 / e2);
+  std::printf(
+      "hinged pendulum, θ0 = %.1f: closed-form period %.9f s (small-amplitude %.9f s); relative error %.3e "
+      "(T/100), %.3e (T/200), ratio %.3f\n",
+      th0, T, compound_pendulum_small_period(Ip, m, g, l), e1, e2, e1 / e2);
   EXPECT_LT(e2, 1e-4);
   EXPECT_NEAR(e1 / e2, 4.0, 0.4);
 }

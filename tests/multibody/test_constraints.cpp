@@ -29,7 +29,8 @@ TEST(RigidBody, EulerTensorMassMatrixAndMomentaMatchTheRotationForm) {
   // E_i = ½(J_j + J_k − J_i), and J_i = E_j + E_k back.
   EXPECT_NEAR(b.euler_tensor()(0), 0.5 * (0.9 + 1.1 - 0.7), 1e-15);
   for (int i = 0; i < 3; ++i)
-    EXPECT_NEAR(b.euler_tensor()((i + 1) % 3) + b.euler_tensor()((i + 2) % 3), b.principal_inertia()(i), 1e-15);
+    EXPECT_NEAR(b.euler_tensor()((i + 1) % 3) + b.euler_tensor()((i + 2) % 3), b.principal_inertia()(i),
+                1e-15);
   std::mt19937 rng(7);
   const Mat3 R = random_rotation(rng);
   const Vec3 phi = random_vec(rng), v = random_vec(rng), w = random_vec(rng, 3.0);
@@ -56,7 +57,8 @@ TEST(RigidBody, OrthonormalityJacobianMatchesFiniteDifferences) {
     Vec12 qp = q, qm = q;
     qp(k) += h;
     qm(k) -= h;
-    const Eigen::Matrix<double, 6, 1> fd = (RigidBody::orthonormality(qp) - RigidBody::orthonormality(qm)) / (2 * h);
+    const Eigen::Matrix<double, 6, 1> fd =
+        (RigidBody::orthonormality(qp) - RigidBody::orthonormality(qm)) / (2 * h);
     EXPECT_LT((G.col(k) - fd).norm(), 1e-9) << "column " << k;
   }
 }
@@ -91,21 +93,24 @@ std::vector<std::unique_ptr<Constraint>> every_kind() {
   c.push_back(spherical_joint("node-ball", PointMap::node_position(kU, Vec3(1, 2, 0)),
                               PointMap::body_point(kB2, X2)));
   c.push_back(revolute_joint("hinge", PointMap::body_point(kB1, X1), PointMap::body_point(kB2, X2),
-                             PointMap::body_vector(kB1, Vec3(0, 0, 1)), PointMap::body_vector(kB2, Vec3(1, 0, 0)),
+                             PointMap::body_vector(kB1, Vec3(0, 0, 1)),
+                             PointMap::body_vector(kB2, Vec3(1, 0, 0)),
                              PointMap::body_vector(kB2, Vec3(0, 1, 0))));
   c.push_back(revolute_joint("ground-hinge", PointMap::body_point(kB2, X2), PointMap::ground(Vec3(0, 0, 1)),
                              PointMap::ground(Vec3(0, 1, 0)), PointMap::body_vector(kB2, Vec3(1, 0, 0)),
                              PointMap::body_vector(kB2, Vec3(0, 0, 1))));
-  c.push_back(rigid_connection("clamp", PointMap::node_position(kU, Vec3(1, 2, 0)), PointMap::vector3(kP), kB1,
-                               Vec3(0.4, 0.1, -0.2), Vec3(0.6, 0.0, 0.8)));
-  c.push_back(rigid_connection("clamp-aligned", PointMap::body_point(kB2, X2), PointMap::body_vector(kB2, Vec3(0, 0, 1)),
-                               kB1, Vec3(0.4, 0.1, -0.2), Vec3(0.6, 0.0, 0.8), DirectorCondition::aligned));
+  c.push_back(rigid_connection("clamp", PointMap::node_position(kU, Vec3(1, 2, 0)), PointMap::vector3(kP),
+                               kB1, Vec3(0.4, 0.1, -0.2), Vec3(0.6, 0.0, 0.8)));
+  c.push_back(rigid_connection("clamp-aligned", PointMap::body_point(kB2, X2),
+                               PointMap::body_vector(kB2, Vec3(0, 0, 1)), kB1, Vec3(0.4, 0.1, -0.2),
+                               Vec3(0.6, 0.0, 0.8), DirectorCondition::aligned));
   c.push_back(orthonormality("frame", kB2));
-  c.push_back(distance("link", PointMap::body_point(kB1, X1), PointMap::node_position(kU, Vec3(1, 2, 0)), 1.3));
+  c.push_back(
+      distance("link", PointMap::body_point(kB1, X1), PointMap::node_position(kU, Vec3(1, 2, 0)), 1.3));
   c.push_back(distance("link-gonzalez", PointMap::body_point(kB2, X2), PointMap::vector3(kP), 0.9,
                        DistanceGradient::gonzalez));
-  c.push_back(prescribed_rotation("hub", kB1, Vec3(0.1, 0.0, 0.0), Vec3(0, 0, 1), Vec3(1, 0, 0), Vec3(0, 0, 0),
-                                  Vec3(0, 0, 1), Vec3(1, 0, 0), spin_up()));
+  c.push_back(prescribed_rotation("hub", kB1, Vec3(0.1, 0.0, 0.0), Vec3(0, 0, 1), Vec3(1, 0, 0),
+                                  Vec3(0, 0, 0), Vec3(0, 0, 1), Vec3(1, 0, 0), spin_up()));
   return c;
 }
 
@@ -239,20 +244,22 @@ TEST(Constraints, BadReferencesAndDuplicateNamesAreRefused) {
     set.add(fixed_point("pin", PointMap::body_point(24, Vec3::Zero()), Vec3::Zero()));
     FAIL() << "a joint on body unknowns 24–26 of a 24-unknown model was accepted";
   } catch (const std::invalid_argument& e) {
-    EXPECT_NE(std::string(e.what()).find("fixed point 'pin' references unknown 26"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("fixed point 'pin' references unknown 26"), std::string::npos)
+        << e.what();
   }
   set.add(orthonormality("frame", 0));
   EXPECT_THROW(set.add(orthonormality("frame", 12)), std::invalid_argument);
-  EXPECT_THROW(prescribed_rotation("hub", 0, Vec3::Zero(), Vec3(0, 0, 2), Vec3(1, 0, 0), Vec3::Zero(), Vec3(0, 0, 1),
-                                   Vec3(1, 0, 0), spin_up()),
+  EXPECT_THROW(prescribed_rotation("hub", 0, Vec3::Zero(), Vec3(0, 0, 2), Vec3(1, 0, 0), Vec3::Zero(),
+                                   Vec3(0, 0, 1), Vec3(1, 0, 0), spin_up()),
                std::invalid_argument);
   EXPECT_THROW(distance("rod", PointMap::vector3(0), PointMap::vector3(3), -1.0), std::invalid_argument);
 }
 
-// §2.4: the discrete constraint forces −Ḡᵀλ of a joint between bodies have zero resultant and zero moment about
-// the origin, taken with the midpoint configuration, on two consistent states — which is what keeps L and J of a
-// conserving step. The distance is checked off its manifold (|r0| ≠ |r1| ≠ L), as in a Newton iterate: there the
-// invariant form (2.5) keeps the property and Gonzalez's generic formula (2.4) does not (§2.3).
+// §2.4: the discrete constraint forces −Ḡᵀλ of a joint between bodies have zero resultant and zero moment
+// about the origin, taken with the midpoint configuration, on two consistent states — which is what keeps L
+// and J of a conserving step. The distance is checked off its manifold (|r0| ≠ |r1| ≠ L), as in a Newton
+// iterate: there the invariant form (2.5) keeps the property and Gonzalez's generic formula (2.4) does not
+// (§2.3).
 TEST(Constraints, JointsBetweenBodiesExertNoDiscreteNetForceOrMoment) {
   std::mt19937 rng(21);
   const Vec3 rA(0.5, 0.1, -0.2), rB(-0.3, 0.2, 0.1), X1(0.2, -0.4, 0.3), X2(0.1, 0.3, -0.2);
@@ -263,12 +270,14 @@ TEST(Constraints, JointsBetweenBodiesExertNoDiscreteNetForceOrMoment) {
     q << RigidBody::state(xA, RA), RigidBody::state(xA + RA * rA - RB * rB, RB);
     return q;
   };
-  const Eigen::VectorXd q0 = consistent(random_rotation(rng), 0.3), q1 = consistent(random_rotation(rng), -1.1);
+  const Eigen::VectorXd q0 = consistent(random_rotation(rng), 0.3),
+                        q1 = consistent(random_rotation(rng), -1.1);
   std::vector<std::unique_ptr<Constraint>> kinds;
   kinds.push_back(orthonormality("A frame", 0));
   kinds.push_back(spherical_joint("ball", PointMap::body_point(0, rA), PointMap::body_point(12, rB)));
   kinds.push_back(revolute_joint("hinge", PointMap::body_point(0, rA), PointMap::body_point(12, rB),
-                                 PointMap::body_vector(0, Vec3::UnitZ()), PointMap::body_vector(12, Vec3::UnitX()),
+                                 PointMap::body_vector(0, Vec3::UnitZ()),
+                                 PointMap::body_vector(12, Vec3::UnitX()),
                                  PointMap::body_vector(12, Vec3::UnitY())));
   kinds.push_back(distance("rod", PointMap::body_point(0, X1), PointMap::body_point(12, X2), 1.0));
   kinds.push_back(distance("rod (Gonzalez)", PointMap::body_point(0, X1), PointMap::body_point(12, X2), 1.0,
@@ -300,8 +309,9 @@ TEST(Constraints, JointsBetweenBodiesExertNoDiscreteNetForceOrMoment) {
   }
 }
 
-// Rank check (§2.5): a body pinned at two points is free only to turn about the line through them, so the 6 + 6
-// rows have rank 11; the check names both pins (and the frame rows they depend on), not the other body's joint.
+// Rank check (§2.5): a body pinned at two points is free only to turn about the line through them, so the 6 +
+// 6 rows have rank 11; the check names both pins (and the frame rows they depend on), not the other body's
+// joint.
 TEST(Constraints, RankCheckNamesTheJointsOfARedundantSet) {
   std::mt19937 rng(1);
   const Mat3 R1 = random_rotation(rng), R2 = random_rotation(rng);
@@ -314,11 +324,12 @@ TEST(Constraints, RankCheckNamesTheJointsOfARedundantSet) {
     s->add(orthonormality("body1 frame", 0));
     s->add(orthonormality("body2 frame", 12));
     s->add(fixed_point("pin A", PointMap::body_point(0, Xa), RigidBody::point(q.segment<12>(0), Xa)));
-    s->add(spherical_joint("knee", PointMap::body_point(0, Xc), PointMap::body_point(12, R2.transpose() *
-                                                                   (RigidBody::point(q.segment<12>(0), Xc) -
-                                                                    q.segment<3>(12)))));
+    s->add(spherical_joint("knee", PointMap::body_point(0, Xc),
+                           PointMap::body_point(12, R2.transpose() * (RigidBody::point(q.segment<12>(0), Xc) -
+                                                                      q.segment<3>(12)))));
     if (redundant)
-      s->add(fixed_point("pin B", PointMap::body_point(0, Xb), RigidBody::point(q.segment<12>(0), Xb) + shift));
+      s->add(
+          fixed_point("pin B", PointMap::body_point(0, Xb), RigidBody::point(q.segment<12>(0), Xb) + shift));
     return s;
   };
   const RankReport ok = build(false, Vec3::Zero())->rank_check(q, 0.0);
@@ -343,9 +354,9 @@ TEST(Constraints, RankCheckNamesTheJointsOfARedundantSet) {
   EXPECT_NE(c.message.find("conflicting constraints"), std::string::npos) << c.message;
 }
 
-// A joint on unknowns a support already fixes: a node whose translations are Dirichlet-fixed and a fixed point
-// on that node. Over the free unknowns the joint's rows vanish, so the check names it; without the mask it
-// passes. A clamp of many nodes to a body is full rank.
+// A joint on unknowns a support already fixes: a node whose translations are Dirichlet-fixed and a fixed
+// point on that node. Over the free unknowns the joint's rows vanish, so the check names it; without the mask
+// it passes. A clamp of many nodes to a body is full rank.
 TEST(Constraints, RankCheckNamesAJointOnFixedUnknowns) {
   constexpr int n = 12 + 3 * 40;
   Eigen::VectorXd q = Eigen::VectorXd::Zero(n);
@@ -376,8 +387,8 @@ TEST(Constraints, RankCheckFlagsAHingeAddedToADrivenHub) {
   q = RigidBody::state(Vec3::Zero(), Mat3::Identity());
   ConstraintSet s(12);
   s.add(orthonormality("hub frame", 0));
-  s.add(prescribed_rotation("drive", 0, Vec3::Zero(), Vec3(0, 0, 1), Vec3(1, 0, 0), Vec3::Zero(), Vec3(0, 0, 1),
-                            Vec3(1, 0, 0), spin_up()));
+  s.add(prescribed_rotation("drive", 0, Vec3::Zero(), Vec3(0, 0, 1), Vec3(1, 0, 0), Vec3::Zero(),
+                            Vec3(0, 0, 1), Vec3(1, 0, 0), spin_up()));
   EXPECT_TRUE(s.rank_check(q, 0.0).message.empty());
   s.add(revolute_joint("extra hinge", PointMap::body_point(0, Vec3::Zero()), PointMap::ground(Vec3::Zero()),
                        PointMap::ground(Vec3(0, 0, 1)), PointMap::body_vector(0, Vec3(1, 0, 0)),

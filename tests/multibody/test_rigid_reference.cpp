@@ -55,7 +55,8 @@ TEST(SphericalChainReference, HeavySymmetricTopKeepsItsThreeInvariants) {
   b.x = b.R * Vector3d(0, 0, l);
   b.v = w.cross(b.x);
   b.omega_body = b.R.transpose() * w;
-  const SphericalChainReference top({b}, {{0, Vector3d(0, 0, -l), -1, Vector3d::Zero()}}, Vector3d(0, 0, -9.81));
+  const SphericalChainReference top({b}, {{0, Vector3d(0, 0, -l), -1, Vector3d::Zero()}},
+                                    Vector3d(0, 0, -9.81));
   const VectorXd y0 = top.initial_state();
   const auto ys = dormand_prince([&](double t, const VectorXd& y, VectorXd& d) { top.rhs(t, y, d); }, 0.0, y0,
                                  {1.0, 5.0}, {});
@@ -84,7 +85,8 @@ TEST(SphericalChainReference, PlanarSwingHasTheCompoundPendulumPeriod) {
   const SphericalChainReference p({b}, {{0, Vector3d(0, 0, l), -1, Vector3d::Zero()}}, Vector3d(0, 0, -g));
   const double Ip = b.J(1) + m * l * l;
   const double T = compound_pendulum_period(Ip, m, g, l, th0);
-  EXPECT_GT(T, compound_pendulum_small_period(Ip, m, g, l) * (1.0 + th0 * th0 / 16.0 - 1e-3));  // 1 + θ0²/16 + …
+  EXPECT_GT(T,
+            compound_pendulum_small_period(Ip, m, g, l) * (1.0 + th0 * th0 / 16.0 - 1e-3));  // 1 + θ0²/16 + …
   const auto ys = dormand_prince([&](double t, const VectorXd& y, VectorXd& d) { p.rhs(t, y, d); }, 0.0,
                                  p.initial_state(), {0.5 * T, T}, {});
   auto angle = [](const VectorXd& y) {
