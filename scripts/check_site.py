@@ -13,11 +13,9 @@ not installed (the ctest then reports "skipped").
 
 import argparse
 import functools
-import html
 import http.server
 import json
 import os
-import re
 import shutil
 import socketserver
 import subprocess
@@ -30,6 +28,7 @@ SKIP = 77
 
 CHECKER = r"""<!doctype html><html><head><meta charset="utf-8"><title>check</title></head><body>
 <pre id="result">running</pre>
+<img src="/_hold" alt="" style="display:none">
 <script>
 const pages = %PAGES%;
 const cache = new Map();
@@ -86,6 +85,7 @@ function load(page) {
     frame.remove();
   }
   document.getElementById('result').textContent = 'RESULT ' + JSON.stringify(out);
+  await fetch('/_result', {method: 'POST', body: JSON.stringify(out)});
 })();
 </script></body></html>
 """
@@ -104,9 +104,34 @@ def chromium_args(exe, profile):
             "--disable-component-update", "--no-first-run", f"--user-data-dir={profile}", "--hide-scrollbars"]
 
 
+RESULT = {"body": None, "done": threading.Event()}
+GIF = bytes.fromhex("47494638396101000100800000000000ffffff21f90401000000002c00000000010001000002024401003b")
+
+
 class QuietHandler(http.server.SimpleHTTPRequestHandler):
+    """Serves the site; /_result receives the checker's report, and /_hold (an image of the checker page)
+    answers only then, so that the page's load event, and with it chromium --dump-dom, waits for the checks."""
+
     def log_message(self, *a):
         pass
+
+    def do_POST(self):
+        if self.path == "/_result":
+            RESULT["body"] = self.rfile.read(int(self.headers.get("Content-Length", "0"))).decode()
+            RESULT["done"].set()
+        self.send_response(204)
+        self.end_headers()
+
+    def do_GET(self):
+        if self.path == "/_hold":
+            RESULT["done"].wait(timeout=500)
+            self.send_response(200)
+            self.send_header("Content-Type", "image/gif")
+            self.send_header("Content-Length", str(len(GIF)))
+            self.end_headers()
+            self.wfile.write(GIF)
+            return
+        super().do_GET()
 
 
 def serve(directory):
@@ -152,14 +177,12 @@ def main():
     httpd, port = serve(site)
     profile = tempfile.mkdtemp(prefix="shelldyn-chromium-")
     try:
-        cmd = chromium_args(exe, profile) + ["--virtual-time-budget=600000", "--dump-dom",
-                                              f"http://127.0.0.1:{port}/_check.html"]
+        cmd = chromium_args(exe, profile) + ["--dump-dom", f"http://127.0.0.1:{port}/_check.html"]
         p = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, timeout=600)
-        m = re.search(r"RESULT (\{.*?\})</pre>", p.stdout, re.S)
-        if not m:
+        if RESULT["body"] is None:
             print("check_site: the checker page did not finish; chromium said:\n" + p.stderr[-2000:])
             return 1
-        r = json.loads(html.unescape(m.group(1)))
+        r = json.loads(RESULT["body"])
         for shot in args.screenshot:
             page, png = shot.split(":", 1)
             subprocess.run(chromium_args(exe, profile) + ["--window-size=1280,900", f"--screenshot={os.path.abspath(png)}",
