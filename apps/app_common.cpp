@@ -8,10 +8,10 @@
 #include "integrators/integrator_settings.hpp"
 #include "integrators/runs/run_driver.hpp"
 #include "lib/openmp_wait_policy.hpp"  // passive OpenMP waiting in every app (linked into each of them)
+#include "integrators/checkpoint/checkpoint.hpp"  // load_saved_state: read_checkpoint (with or without MPI)
+#include "lib/state_output.hpp"                   // load_saved_state: state_from_vtu
 #ifdef SHELLDYN_HAVE_MPI
 #include "integrators/runs/mpi_executor.hpp"
-#include "integrators/checkpoint/checkpoint.hpp"
-#include "lib/state_output.hpp"
 #endif
 
 
@@ -54,13 +54,16 @@ namespace {
 #define SHELLDYN_SOURCE_DIR ""
 #endif
 
+// Installed files first (<prefix>/share/shelldyn/..., beside <prefix>/bin/ of this executable), then the
+// source tree the binary was built from: an installed shelldyn must use, and so test, what was installed.
+// A build-tree binary has no build/share/shelldyn and falls through to the source tree.
 std::vector<fs::path> search_dirs(const std::string& sub_source, const std::string& sub_install) {
   std::vector<fs::path> dirs;
-  const std::string src = SHELLDYN_SOURCE_DIR;
-  if (!src.empty()) dirs.push_back(fs::path(src) / sub_source);
   std::error_code ec;
   const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
   if (!ec) dirs.push_back(exe.parent_path().parent_path() / sub_install);
+  const std::string src = SHELLDYN_SOURCE_DIR;
+  if (!src.empty()) dirs.push_back(fs::path(src) / sub_source);
   return dirs;
 }
 

@@ -56,7 +56,8 @@ namespace {
 using Action = std::function<int()>;
 
 std::string version_text() {
-  return "shelldyn " + shelldyn_version() + " (SUNDIALS " + sundials_version() + ", Eigen " + eigen_version() + ")";
+  return "shelldyn " + shelldyn_version() + " (SUNDIALS " + sundials_version() + ", Eigen " + eigen_version() + ")" +
+         (shelldyn_git_commit().empty() ? "" : "\ngit commit " + shelldyn_git_commit());
 }
 
 std::string one_line(std::string s) {

@@ -128,6 +128,7 @@ std::string run_json(const CaseSpec& c, const RunInfo& info) {
   if (!info.command.empty()) j["command"] = info.command;
   Json& v = j["versions"];
   v["shelldyn"] = shelldyn_version();
+  if (!shelldyn_git_commit().empty()) v["git_commit"] = shelldyn_git_commit();
   v["sundials"] = info.sundials_version.empty() ? "not used" : info.sundials_version;
   v["eigen"] = eigen_version();
   v["nlohmann_json"] = std::to_string(NLOHMANN_JSON_VERSION_MAJOR) + "." + std::to_string(NLOHMANN_JSON_VERSION_MINOR) +

@@ -18,6 +18,8 @@ namespace shelldyn {
 
 // Version of this library (the SHELLDYN_VERSION compile definition of shelldyn_core).
 std::string shelldyn_version();
+// The git commit this build was made from ("-dirty" appended for local changes), "" outside a checkout.
+std::string shelldyn_git_commit();
 // "3.4.0": from Eigen's version macros.
 std::string eigen_version();
 

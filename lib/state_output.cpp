@@ -60,6 +60,9 @@ VtuFields state_fields(const Model& model, const State& state, const Eigen::Vect
     put(ef, r.membrane_strain), put(kf, r.curvature), put(gf, r.shear_strain);
     uf.values.push_back(r.energy_density);
   }
+  // Components in the element's local frame (elements/cr9_shell.hpp Resultants; docs/manual.md §4).
+  for (ScalarField* s : {&Nf, &Mf, &ef, &kf}) s->component_names = {"11", "22", "12"};
+  for (ScalarField* s : {&Qf, &gf}) s->component_names = {"1", "2"};
   for (ScalarField* s : {&Nf, &Mf, &Qf, &ef, &kf, &gf, &uf}) f.cell_scalars.push_back(std::move(*s));
   return f;
 }

@@ -68,15 +68,26 @@ void check_size(size_t got, size_t want, const std::string& what) {
                                 std::to_string(want));
 }
 
+// ComponentName0="X" ... attributes of a DataArray (VTK XML format): ParaView labels the components with them.
+std::string component_attributes(int components, const std::vector<std::string>& names) {
+  std::vector<std::string> use = names;
+  if (use.empty() && components == 3) use = {"X", "Y", "Z"};
+  std::string out;
+  for (size_t c = 0; c < use.size(); ++c)
+    out += " ComponentName" + std::to_string(c) + "=\"" + xml_escape(use[c]) + "\"";
+  return out;
+}
+
 void write_vectors(std::FILE* f, const char* name, const std::vector<Vec3>& v) {
-  std::fprintf(f, "        <DataArray type=\"Float64\" Name=\"%s\" NumberOfComponents=\"3\" format=\"ascii\">\n", name);
+  std::fprintf(f, "        <DataArray type=\"Float64\" Name=\"%s\" NumberOfComponents=\"3\"%s format=\"ascii\">\n", name,
+               component_attributes(3, {}).c_str());
   for (const Vec3& x : v) std::fprintf(f, "          %.17g %.17g %.17g\n", x.x(), x.y(), x.z());
   std::fprintf(f, "        </DataArray>\n");
 }
 
 void write_scalars(std::FILE* f, const ScalarField& s) {
-  std::fprintf(f, "        <DataArray type=\"Float64\" Name=\"%s\" NumberOfComponents=\"%d\" format=\"ascii\">\n",
-               xml_escape(s.name).c_str(), s.components);
+  std::fprintf(f, "        <DataArray type=\"Float64\" Name=\"%s\" NumberOfComponents=\"%d\"%s format=\"ascii\">\n",
+               xml_escape(s.name).c_str(), s.components, component_attributes(s.components, s.component_names).c_str());
   const size_t nc = static_cast<size_t>(s.components);
   for (size_t k = 0; k < s.values.size(); k += nc) {
     std::fprintf(f, "         ");
@@ -103,6 +114,7 @@ void write_vtu(const std::string& path, const Mesh& mesh, const VtuFields& field
   for (const auto& s : fields.point_scalars) {
     if (s.components < 1) throw std::invalid_argument("write_vtu: field '" + s.name + "' has < 1 component");
     check_size(s.values.size(), np * static_cast<size_t>(s.components), "point field '" + s.name + "'");
+    if (!s.component_names.empty()) check_size(s.component_names.size(), static_cast<size_t>(s.components), "point field '" + s.name + "''s component_names");
     if (s.name.empty() || !names.insert(s.name).second)
       throw std::invalid_argument("write_vtu: point field name '" + s.name + "' is empty or repeated");
   }
@@ -110,6 +122,7 @@ void write_vtu(const std::string& path, const Mesh& mesh, const VtuFields& field
   for (const auto& s : fields.cell_scalars) {
     if (s.components < 1) throw std::invalid_argument("write_vtu: field '" + s.name + "' has < 1 component");
     check_size(s.values.size(), ne * static_cast<size_t>(s.components), "cell field '" + s.name + "'");
+    if (!s.component_names.empty()) check_size(s.component_names.size(), static_cast<size_t>(s.components), "cell field '" + s.name + "''s component_names");
     if (s.name.empty() || !cell_names.insert(s.name).second)
       throw std::invalid_argument("write_vtu: cell field name '" + s.name + "' is empty or repeated");
   }

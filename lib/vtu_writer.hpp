@@ -22,6 +22,9 @@ struct ScalarField {
   std::string name;
   std::vector<double> values;  // `components` per point (point data) or per element (cell data)
   int components = 1;          // > 1: a vector/tensor field, values interleaved per point/element
+  // Names of the components, written as ComponentName0.. attributes (ParaView shows them instead of
+  // 0, 1, 2). Empty: X, Y, Z for a 3-component field, no names otherwise.
+  std::vector<std::string> component_names = {};
 };
 
 struct VtuFields {

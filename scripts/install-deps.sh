@@ -3,6 +3,7 @@
 # Idempotent: does nothing (not even `apt-get update`) when every package is already installed.
 #   bash scripts/install-deps.sh              # what the default build and tests need
 #   bash scripts/install-deps.sh --with-mpi   # also Open MPI: MPI-distributed sweeps (docs/cluster-sweeps.md)
+#   bash scripts/install-deps.sh --with-docs  # also MkDocs, Doxygen, Chromium: the documentation site (scripts/docs.sh)
 set -euo pipefail
 
 PACKAGES=(
@@ -23,9 +24,13 @@ PACKAGES=(
 # Not listed (opt-in tools): clang-14 libclang-rt-14-dev for scripts/fuzz.sh (libFuzzer); .ci/run
 # installs them itself when SHELLDYN_CI_SANITIZE=1.
 
-if [ "${1:-}" = "--with-mpi" ]; then
-  PACKAGES+=(libopenmpi-dev openmpi-bin)   # optional: SHELLDYN_WITH_MPI, `mpirun -n P shelldyn compare`
-fi
+for flag in "$@"; do
+  case "$flag" in
+    --with-mpi) PACKAGES+=(libopenmpi-dev openmpi-bin) ;;   # optional: SHELLDYN_WITH_MPI, `mpirun -n P shelldyn compare`
+    --with-docs) PACKAGES+=(mkdocs doxygen chromium) ;;     # optional: the documentation site (scripts/docs.sh) and its browser test
+    *) echo "install-deps: unknown option '$flag' (use --with-mpi, --with-docs)" >&2; exit 2 ;;
+  esac
+done
 
 missing=()
 for p in "${PACKAGES[@]}"; do

@@ -52,6 +52,14 @@ def main():
     if len(types) != 1 or [int(t) for t in types[0].text.split()] != [28] * ncells:
         fail(f"{vtu}: cell types are not all 28")
 
+    # Every vector/tensor array names its components (ComponentName0.. attributes: ParaView's labels).
+    for a in root.iter("DataArray"):
+        n = int(a.get("NumberOfComponents", "1"))
+        if a.get("Name") and n > 1:
+            missing = [c for c in range(n) if not a.get(f"ComponentName{c}")]
+            if missing:
+                fail(f"{vtu}: DataArray '{a.get('Name')}' has no ComponentName{missing[0]}")
+
     pvd = ET.parse(os.path.join(out, "fields.pvd")).getroot()
     sets = pvd.findall("./Collection/DataSet")
     if len(sets) != 1 or float(sets[0].get("timestep")) != 0.0:

@@ -137,6 +137,28 @@ TEST(VtuWriter, WritesBiquadraticQuadsWithFields) {
   EXPECT_NE(xml.find("          0 2 12 10 1 7 11 5 6\n"), std::string::npos);  // connectivity in mesh order
 }
 
+TEST(VtuWriter, VectorAndTensorFieldsNameTheirComponents) {
+  const fs::path dir = scratch_dir("vtu_names");
+  const Mesh m = two_element_mesh();
+  VtuFields f;
+  f.displacement.assign(m.X.size(), Vec3::Zero());
+  f.velocity.assign(m.X.size(), Vec3::Zero());
+  f.director.assign(m.X.size(), Vec3::UnitZ());
+  f.point_scalars.push_back({"reaction", std::vector<double>(3 * m.X.size(), 0.0), 3});
+  f.cell_scalars.push_back({"shear_force", {0.0, 1.0, 2.0, 3.0}, 2, {"1", "2"}});
+  write_vtu((dir / "a.vtu").string(), m, f);
+  const std::string xml = read_text(dir / "a.vtu");
+  for (const char* name : {"displacement", "velocity", "director", "reaction"})
+    EXPECT_NE(xml.find(std::string("Name=\"") + name +
+                       "\" NumberOfComponents=\"3\" ComponentName0=\"X\" ComponentName1=\"Y\" ComponentName2=\"Z\""),
+              std::string::npos)
+        << name;
+  EXPECT_NE(xml.find("Name=\"shear_force\" NumberOfComponents=\"2\" ComponentName0=\"1\" ComponentName1=\"2\""),
+            std::string::npos);
+  f.cell_scalars.back().component_names = {"1"};  // one name for two components
+  EXPECT_THROW(write_vtu((dir / "b.vtu").string(), m, f), std::invalid_argument);
+}
+
 TEST(VtuWriter, RejectsWrongFieldSizes) {
   const fs::path dir = scratch_dir("vtu_bad");
   const Mesh m = two_element_mesh();
