@@ -34,7 +34,9 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
     // Theory §6: on a linear oscillator the step is k[(½+ξ)u_{n+1} + (½−ξ)u_n], whose root tends to
     // (½−ξ)/(½+ξ) as ωΔt → ∞; ρ∞ < 1 asks for that limit, i.e. ξ = (1−ρ∞)/(2(1+ρ∞)).
     xi_ = xi + (1.0 - rho_inf) / (2.0 * (1.0 + rho_inf));
-    const std::string newton = s.get("newton", "full");
+    // Modified Newton by default, as em-galpha (docs/theory/newton-iteration.md §1): K̄ kept and corotated, the
+    // trapezoidal predictor, certify = predicted; a failed step is retried with full Newton from u_n.
+    const std::string newton = s.get("newton", "modified");
     if (newton != "full" && newton != "modified")
       throw std::invalid_argument("em-exact.newton: '" + newton + "' (use full or modified)");
     nopt_.modified = (newton == "modified");

@@ -11,7 +11,7 @@
 //   K + V − W_ext constant (ξ = 0) or decreasing by Σ ξ ΔuᵀGΔu ≥ 0 per step; L exact; J exact without loads.
 //
 // Settings: rho_inf [1] and xi [0] (dissipation; ξ_eff = ξ + (1−ρ∞)/(2(1+ρ∞)), theory §6),
-//   newton full|modified [full], refresh [0.03 with modified Newton, else 0: refresh K̄ when the observed
+//   newton modified|full [modified], refresh [0.03 with modified Newton, else 0: refresh K̄ when the observed
 //   contraction exceeds it], refresh_cost [0: off; opt-in renewal rule, also refresh K̄ when a step's iterations
 //   exceed the average since the last refresh with the refresh counted as this many iterations, theory §5.5],
 //   setup_every [20; 1e6 when refresh > 0], predictor none|trapezoidal|trapezoidal-v|newmark [trapezoidal with
