@@ -220,12 +220,12 @@ class NewmarkFamily final : public Integrator {
       if (step(sys, s, h, rep, &why, /*full_newton=*/true)) return;
       ++rep.rejected_steps;
     }
-    if (depth >= max_cuts_) {
+    if (depth >= max_cuts_) {  // one line: where, why (the last attempt's), and the setting that would help
       std::ostringstream msg;
-      msg.precision(10);
-      msg << name_ << ": step " << steps_ + 1 << " from t = " << s.t << " with dt = " << h << " failed"
-          << (max_cuts_ > 0 ? " after " + std::to_string(depth) + " cuts" : std::string(" (step cutting is off: set max_cuts)"))
-          << ": " << why;
+      msg.precision(6);
+      msg << name_ << ": step " << steps_ + 1 << " at t = " << s.t << " (dt = " << h << ") failed"
+          << (max_cuts_ > 0 ? " after " + std::to_string(depth) + " cuts" : std::string()) << ": " << why << "; set max_cuts="
+          << max_cuts_ + (max_cuts_ > 0 ? 2 : 4) << " (halve the failing step)";
       throw StepFailure(msg.str());
     }
     step_with_cuts(sys, s, 0.5 * h, depth + 1, rep);
@@ -372,7 +372,16 @@ class NewmarkFamily final : public Integrator {
     rep.residual_norm = r.fnorm;
     rep.energy_ratio = r.energy_ratio;
     if (!r.converged) {
-      *why = r.message + " (cc = " + std::to_string(r.energy_ratio) + ", iterations = " + std::to_string(r.iterations) + ")";
+      // One short line (docs/theory/newton-iteration.md §4): iterations, the last residual and energy ratio, each once.
+      char b[200];
+      if (r.stop_reason == NewtonSolver::StopReason::max_iters) {
+        std::snprintf(b, sizeof b, "no convergence in %d iterations, |r|inf = %.3g, energy ratio cc = %.3g (cc_tol = %.3g)",
+                      r.iterations, r.fnorm, r.energy_ratio, nopt_.energy_tol);
+        *why = b;
+      } else {  // a failed residual, Jacobian or solve: the solver's reason, first line
+        *why = r.message.substr(0, r.message.find_first_of(";\n"));
+        if (why->size() > 100) *why = why->substr(0, 97) + "...";
+      }
       return false;
     }
     if (residual_trace_) residual_trace_(trace, r.iterations);
