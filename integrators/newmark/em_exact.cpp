@@ -610,12 +610,12 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
         *why = r.message.substr(0, r.message.find_first_of(";\n"));
         if (why->size() > 100) *why = why->substr(0, 97) + "...";
       }
-      if (stalled && last > stall_ceiling()) {
+      if (stalled && last > stall_ceiling()) {  // stalled above max(stall_tol, round-off level): accept it, or cut
         std::snprintf(b, sizeof b, "%.0e", 3.0 * last);
-        hint_ = "set max_cuts=4 (halve the failing step), or stall_tol=" + std::string(b) +
-                " to accept a residual that stalls above the round-off ceiling " + fmt(stall_ceiling());
+        *why += ", stalled above " + fmt(stall_ceiling());
+        hint_ = "set max_cuts=4 (halve the step) or stall_tol=" + std::string(b);
       } else {
-        hint_ = "set max_cuts=4 (halve the failing step)";
+        hint_ = "set max_cuts=4 (halve the step)";
       }
       return false;
     }

@@ -225,7 +225,7 @@ class NewmarkFamily final : public Integrator {
       msg.precision(6);
       msg << name_ << ": step " << steps_ + 1 << " at t = " << s.t << " (dt = " << h << ") failed"
           << (max_cuts_ > 0 ? " after " + std::to_string(depth) + " cuts" : std::string()) << ": " << why << "; set max_cuts="
-          << max_cuts_ + (max_cuts_ > 0 ? 2 : 4) << " (halve the failing step)";
+          << max_cuts_ + (max_cuts_ > 0 ? 2 : 4) << " (halve the step)";
       throw StepFailure(msg.str());
     }
     step_with_cuts(sys, s, 0.5 * h, depth + 1, rep);
