@@ -703,8 +703,8 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
   double floor_margin_ = 1.5;
   double predict_factor_ = 1.0;
   double refresh_cost_ = 0.0;   // renewal rule (theory §5.5); 0 = off
-  double kbar_row_sum_[2] = {0.0, 0.0};
-  std::string hint_;  // the setting that would help the last failed step (step_with_cuts' message)  // max_i Σ_j |K̄_ij| of the last K̄ of the modified [0] and full [1] solver
+  double kbar_row_sum_[2] = {0.0, 0.0};  // max_i Σ_j |K̄_ij| of the last K̄ of the modified [0] and full [1] solver
+  std::string hint_;  // the setting that would help the last failed step (step_with_cuts' message)
   long renew_steps_ = 0;        // steps since the last refresh of K̄
   long renew_iterations_ = 0;   // their iterations
   static constexpr long kFloorSteps = 16;
