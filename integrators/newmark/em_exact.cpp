@@ -23,6 +23,24 @@
 namespace shelldyn {
 namespace {
 
+std::string fmt(double x) {  // %.6g
+  char b[32];
+  std::snprintf(b, sizeof b, "%.6g", x);
+  return b;
+}
+
+// max_i Σ_j |J_ij| of a matrix with a full (symmetric) pattern: the column sums are the row sums.
+double max_row_abs_sum(const SparseMatrix& J) {
+  const SparsePattern& p = *J.pattern;
+  double m = 0.0;
+  for (Index c = 0; c < p.n; ++c) {
+    double sum = 0.0;
+    for (Index k = p.colptr[static_cast<size_t>(c)]; k < p.colptr[static_cast<size_t>(c) + 1]; ++k) sum += std::abs(J.values[static_cast<size_t>(k)]);
+    m = std::max(m, sum);
+  }
+  return m;
+}
+
 class EmExact final : public Integrator, public EmExactDiagnostics {
  public:
   EmExact(IntegratorSettings& s, double dt) : dt_(dt) {
@@ -34,7 +52,9 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
     // Theory §6: on a linear oscillator the step is k[(½+ξ)u_{n+1} + (½−ξ)u_n], whose root tends to
     // (½−ξ)/(½+ξ) as ωΔt → ∞; ρ∞ < 1 asks for that limit, i.e. ξ = (1−ρ∞)/(2(1+ρ∞)).
     xi_ = xi + (1.0 - rho_inf) / (2.0 * (1.0 + rho_inf));
-    const std::string newton = s.get("newton", "full");
+    // Modified Newton by default, as em-galpha (docs/theory/newton-iteration.md §1): K̄ kept and corotated, the
+    // trapezoidal predictor, certify = predicted; a failed step is retried with full Newton from u_n.
+    const std::string newton = s.get("newton", "modified");
     if (newton != "full" && newton != "modified")
       throw std::invalid_argument("em-exact.newton: '" + newton + "' (use full or modified)");
     nopt_.modified = (newton == "modified");
@@ -302,12 +322,12 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
       ++rep.rejected_steps;
     }
     if (depth >= max_cuts_) {
-      std::ostringstream msg;
-      msg.precision(10);
-      msg << "em-exact: step " << steps_ + 1 << " from t = " << s.t << " with dt = " << h << " failed"
-          << (max_cuts_ > 0 ? " after " + std::to_string(depth) + " cuts" : std::string(" (step cutting is off: set max_cuts)"))
-          << ": " << why;
-      throw StepFailure(msg.str());
+      // One line: where, why (the last attempt's), and the setting that would help (step()).
+      std::string hint = hint_;
+      if (max_cuts_ > 0 && hint.find("max_cuts=4") != std::string::npos)
+        hint.replace(hint.find("max_cuts=4"), 10, "max_cuts=" + std::to_string(max_cuts_ + 2));
+      throw StepFailure("em-exact: step " + std::to_string(steps_ + 1) + " at t = " + fmt(s.t) + " (dt = " + fmt(h) + ") failed" +
+                        (max_cuts_ > 0 ? " after " + std::to_string(depth) + " cuts" : std::string()) + ": " + why + "; " + hint);
     }
     step_with_cuts(s, 0.5 * h, depth + 1, rep);
     step_with_cuts(s, 0.5 * h, depth + 1, rep);
@@ -391,6 +411,7 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
     sys.step_energies(un_, charts, Un_);  // U(u_n) from the step's element state (no extra element pass)
 
     std::vector<double> history;  // scaled residual of every evaluated iterate
+    double last_scale = 0.0;      // force scale of the last evaluated residual (the denominator of ρ)
     double best = std::numeric_limits<double>::infinity();
     ExactEnergySystem::ExactForceInfo finfo;
     int last_jacobian_iter = 0;
@@ -417,6 +438,7 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
       if (!r.allFinite()) throw std::runtime_error("non-finite residual");
       const double rn = r.cwiseAbs().maxCoeff();
       const double rel = rn == 0.0 ? 0.0 : rn / scale;
+      last_scale = scale;
       history.push_back(rel);
       best = std::min(best, rel);
       // The accepted iterate is the last one evaluated, not the one with the smallest residual: at the
@@ -436,6 +458,7 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
       if (!full_newton && kept_.replay(J, newton, basis, up)) {  // first setup after restore(): the saved K̄, not a new one
         // The uninterrupted run reuses this K̄ from an earlier step here: last_jacobian_iter stays 0.
         replayed = true;
+        kbar_row_sum_[0] = max_row_abs_sum(J);  // the saved K̄'s, as the uninterrupted run computed it
         return;
       }
       last_jacobian_iter = static_cast<int>(history.size());  // used for the iteration that follows
@@ -448,6 +471,7 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
       const double cm = 2.0 / (h * h);
       for (size_t k = 0; k < J.values.size(); ++k) J.values[k] = cm * M_.values[k] + 0.5 * K_.values[k];
       apply_dirichlet(sys.dofs(), J, nullptr);
+      kbar_row_sum_[full_newton ? 1 : 0] = max_row_abs_sum(J);
       if (nopt_.modified && !full_newton) kept_.keep(J, umid_, charts);  // for save()
     };
     double first_step = 0.0;  // scaled size of the first correction
@@ -465,8 +489,18 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
     // scaled correction max_i |Δu_k,i| / max(1, |u_n,i|) ≤ step_tol (round-off reached).
     EnergyFloorTest energy_floor(energy_rule_ ? e_floor_ * (energy0_ + std::abs(work_)) : 0.0, true);
     double energy_first = 0.0;  // E_1
+    // The residual's round-off level (docs/theory/newton-iteration.md §3): one unit in the last place of every unknown,
+    // max(1, ‖u_n‖∞)·ε, moves a row of the residual by up to Σ_j |K̄_ij| times it (K̄ is ∂r/∂u), so no iteration
+    // gets ρ below ~ε·max_i Σ_j |K̄_ij|·max(1, ‖u_n‖∞) / scale. It grows with E (the membrane stiffness) and with the
+    // mesh (stiffer elements), and a stall at or below it is the floor whatever stall_tol says.
+    const double u_max = std::max(1.0, un_.cwiseAbs().maxCoeff());
+    auto stall_ceiling = [&] {
+      const double level = std::numeric_limits<double>::epsilon() * kbar_row_sum_[full_newton ? 1 : 0] * u_max;
+      return last_scale > 0.0 ? std::max(stall_tol_, level / last_scale) : stall_tol_;
+    };
     auto hook = [&](int k, const double*, const double* du, const double* f) -> bool {
       const double rk = history.back();
+      const double ceiling = stall_ceiling();
       const Eigen::Map<const Eigen::VectorXd> d(du, n);
       const double step = (d.cwiseAbs().array() * uscale_.array()).maxCoeff();
       if (k == 1) first_step = step;
@@ -485,7 +519,7 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
       double prev_best = std::numeric_limits<double>::infinity();
       for (size_t j = 0; j + 1 < history.size(); ++j) prev_best = std::min(prev_best, history[j]);
       const bool converged_step = step <= stall_step_ * first_step;
-      if (rk <= stall_tol_ && rk > stall_ratio_ * prev_best) {
+      if (rk <= ceiling && rk > stall_ratio_ * prev_best) {
         // Stagnation at the round-off floor if the iteration matrix was fresh, or if the corrections have
         // already shrunk by stall_step relative to the first (the iteration converged; what stalls is the
         // residual's round-off, theory §5), or if the residual is at the floor of the recent steps; otherwise
@@ -503,13 +537,13 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
       // floor_margin of the floor of the recent steps; u_k = u_{k−1} + Δu_k is then the iterate that the
       // stall rule accepts after evaluating r(u_k), and it is accepted without that residual.
       accept_last_evaluated = false;
-      if (certify_floor_ && recent_floor > 0.0 && converged_step && rk <= stall_tol_ && rk <= floor_margin_ * recent_floor)
+      if (certify_floor_ && recent_floor > 0.0 && converged_step && rk <= ceiling && rk <= floor_margin_ * recent_floor)
         return true;
       // certify = predicted (theory §5.4): u_k unevaluated when the iteration contracts (residual and correction)
       // and the residual it predicts for u_k, ρ_{k−1}·(ρ_{k−1}/ρ_{k−2}), is within the floor's margin. Not from
       // ρ_1/ρ_0: the first correction removes the predictor's error far better than the later ones contract
       // (hemisphere: 1e-7 against 1e-3), so that ratio would predict the floor two corrections too early.
-      if (!predict || recent_floor <= 0.0 || history.size() < 3 || rk > stall_tol_) return false;
+      if (!predict || recent_floor <= 0.0 || history.size() < 3 || rk > ceiling) return false;
       const double rp = history[history.size() - 2];
       return rk < rp && step < 0.5 * step_before && predict_factor_ * rk * (rk / rp) <= floor_margin_ * recent_floor;
     };
@@ -556,9 +590,32 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
     rep.rhs_evaluations += r.residual_evals;
     rep.residual_norm = history.empty() ? 0.0 : history.back();
     if (!r.converged) {
-      std::ostringstream os;
-      os << r.message << " (best scaled residual " << best << ", iterations = " << r.iterations << ")";
-      *why = os.str();
+      // One short, true line (docs/theory/newton-iteration.md §4): the last scaled residual, the lowest one only if
+      // it is lower, and the setting that would help: a stall above the round-off ceiling asks for stall_tol, an
+      // iteration that diverged or crawled for smaller steps (max_cuts).
+      char b[200];
+      const double last = history.empty() ? std::numeric_limits<double>::quiet_NaN() : history.back();
+      double prev_best = std::numeric_limits<double>::infinity();
+      for (size_t j = 0; j + 1 < history.size(); ++j) prev_best = std::min(prev_best, history[j]);
+      const bool stalled = history.size() >= 3 && last <= 1e-3 && last > stall_ratio_ * prev_best;
+      if (r.stop_reason == NewtonSolver::StopReason::max_iters) {
+        std::snprintf(b, sizeof b, "no convergence in %d iterations, scaled residual %.3g", r.iterations, last);
+        *why = b;
+        if (best < last) {
+          std::snprintf(b, sizeof b, " (lowest %.3g)", best);
+          *why += b;
+        }
+      } else {
+        *why = r.message.substr(0, r.message.find_first_of(";\n"));
+        if (why->size() > 100) *why = why->substr(0, 97) + "...";
+      }
+      if (stalled && last > stall_ceiling()) {  // stalled above max(stall_tol, round-off level): accept it, or cut
+        std::snprintf(b, sizeof b, "%.0e", 3.0 * last);
+        *why += ", stalled above " + fmt(stall_ceiling());
+        hint_ = "set max_cuts=4 (halve the step) or stall_tol=" + std::string(b);
+      } else {
+        hint_ = "set max_cuts=4 (halve the step)";
+      }
       return false;
     }
     if (residual_trace_) residual_trace_(history, r.iterations);  // ρ_k as the stopping rule sees it (theory §5)
@@ -645,6 +702,8 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
   double floor_margin_ = 1.5;
   double predict_factor_ = 1.0;
   double refresh_cost_ = 0.0;   // renewal rule (theory §5.5); 0 = off
+  double kbar_row_sum_[2] = {0.0, 0.0};  // max_i Σ_j |K̄_ij| of the last K̄ of the modified [0] and full [1] solver
+  std::string hint_;  // the setting that would help the last failed step (step_with_cuts' message)
   long renew_steps_ = 0;        // steps since the last refresh of K̄
   long renew_iterations_ = 0;   // their iterations
   static constexpr long kFloorSteps = 16;

@@ -11,13 +11,14 @@
 //   K + V − W_ext constant (ξ = 0) or decreasing by Σ ξ ΔuᵀGΔu ≥ 0 per step; L exact; J exact without loads.
 //
 // Settings: rho_inf [1] and xi [0] (dissipation; ξ_eff = ξ + (1−ρ∞)/(2(1+ρ∞)), theory §6),
-//   newton full|modified [full], refresh [0.03 with modified Newton, else 0: refresh K̄ when the observed
+//   newton modified|full [modified], refresh [0.03 with modified Newton, else 0: refresh K̄ when the observed
 //   contraction exceeds it], refresh_cost [0: off; opt-in renewal rule, also refresh K̄ when a step's iterations
 //   exceed the average since the last refresh with the refresh counted as this many iterations, theory §5.5],
 //   setup_every [20; 1e6 when refresh > 0], predictor none|trapezoidal|trapezoidal-v|newmark [trapezoidal with
 //   modified Newton, else none; trapezoidal-v leaves out the directors' acceleration term, theory §5.7; newmark
 //   takes the end-point accelerations of Newmark's recursion, em-galpha's predictor, theory §5.9], linear_solver [cholmod], solve_precision [double] (or single: float copy
-//   of the factor, docs/dependencies.md §5.5), res_tol [1e-12], stall_tol [1e-6], stall_ratio [0.5],
+//   of the factor, docs/dependencies.md §5.5), res_tol [1e-12], stall_tol [1e-6; a stall below the residual's round-off level
+//   ε max_i Σ_j |K̄_ij| max(1, ‖u_n‖∞) / scale counts as well, docs/theory/newton-iteration.md §3], stall_ratio [0.5],
 //   stall_step [1e-6], max_iters [25], max_cuts [0], hysteresis [1], certify auto|residual|floor|predicted|energy
 //   [auto: with modified Newton predicted, or floor when the system prescribes displacements (theory §5.8); else
 //   residual] and floor_margin [1.5] (theory §5.3), predict_factor [1] (certify = predicted: safety factor on

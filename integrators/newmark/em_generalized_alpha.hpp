@@ -16,7 +16,7 @@
 //
 // Settings (case file `integrator:` block or --set key=value):
 //   rho_inf [1], xi [0] (em-galpha), beta [0.25] and gamma [0.5] (newmark),
-//   newton: full|modified [full]. Modified Newton keeps K̄'s factorization over iterations and steps and
+//   newton: modified|full [modified]. Modified Newton keeps K̄'s factorization over iterations and steps and
 //     refreshes it when the observed contraction θ = ‖Δu_k‖/‖Δu_{k−1}‖ exceeds refresh [0.1] (0: every
 //     setup_every [20] iterations instead); it starts from the Newmark predictor (predictor: none|newmark
 //     [newmark with modified, none with full]; none = u_n as in §6.4) and stops on the first of: the paper's

@@ -277,8 +277,34 @@ TEST(EmGeneralizedAlpha, FailedStepReportsStepTimeAndResidual) {
     EXPECT_NE(msg.find("step 1"), std::string::npos) << msg;
     EXPECT_NE(msg.find("t = 0"), std::string::npos) << msg;
     EXPECT_NE(msg.find("max_cuts"), std::string::npos) << msg;
+    // One short line that states each quantity once (docs/theory/newton-iteration.md §4): before, the energy ratio
+    // came twice, once as std::to_string's "cc = 0.000000".
+    std::printf("message (%zu characters): %s\n", msg.size(), msg.c_str());
+    EXPECT_EQ(msg.find('\n'), std::string::npos) << msg;
+    EXPECT_LT(msg.size(), 200u) << msg;
+    EXPECT_EQ(msg.find("cc ="), msg.rfind("cc =")) << msg;
+    EXPECT_EQ(msg.find("0.000000"), std::string::npos) << msg;
   }
   EXPECT_EQ(s.t, 0.0);  // the state is the last converged one
+  // A step that runs out of iterations: the iterations, the residual and the energy ratio, each once.
+  auto soft = free_plate(2.0, 1.0, 2, 1, ShellMaterial{1e6, 0.3, 1.0, 0.1});
+  State s2 = soft->initial_state();
+  set_free_flight_velocity(*soft, s2, kV0, kW, 0.5);
+  auto short_of_iterations = make("em-galpha", 0.02, {{"max_iters", "1"}});
+  short_of_iterations->initialize(*soft, s2);
+  try {
+    short_of_iterations->advance(*soft, s2, 0.02);
+    FAIL() << "expected a StepFailure";
+  } catch (const StepFailure& e) {
+    const std::string msg = e.what();
+    std::printf("message (%zu characters): %s\n", msg.size(), msg.c_str());
+    EXPECT_NE(msg.find("step 1 at t = 0"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("no convergence in 1 iterations"), std::string::npos) << msg;
+    EXPECT_EQ(msg.find("cc ="), msg.rfind("cc =")) << msg;
+    EXPECT_EQ(msg.find("KIN"), std::string::npos) << msg;
+    EXPECT_LT(msg.size(), 200u) << msg;
+    EXPECT_NE(msg.find("max_cuts="), std::string::npos) << msg;
+  }
 }
 
 TEST(EmGeneralizedAlpha, RejectsBadSettings) {
