@@ -6,16 +6,23 @@
 #include "integrators/newmark/em_generalized_alpha.hpp"
 
 #include <map>
+#include <mutex>
+#include <stdexcept>
 
 namespace shelldyn {
 namespace {
 struct Entry {
   IntegratorFactory factory;
   std::string summary;
+  std::string origin;
 };
-// The registry: one line per integrator.
-const std::map<std::string, Entry>& registry() {
-  static const std::map<std::string, Entry> r = {
+std::mutex& registry_mutex() {
+  static std::mutex m;
+  return m;
+}
+// The registry: one line per built-in integrator; register_integrator() adds more.
+std::map<std::string, Entry>& registry_table() {
+  static std::map<std::string, Entry> r = {
       {"em-galpha", {make_em_galpha, "energy-momentum generalized-alpha of Li & Qian (2025): strain-averaged internal force"}},
       {"em-exact", {make_em_exact, "exactly energy-momentum conserving step: embedded director velocities, corrected element forces (docs/theory/exact-energy-momentum.md)"}},
       {"galpha", {make_galpha, "Chung-Hulbert generalized-alpha: alpha_f-weighted end-point internal forces"}},
@@ -27,7 +34,36 @@ const std::map<std::string, Entry>& registry() {
   };
   return r;
 }
+// A copy, so that factories run without the lock (a factory may itself register or look up integrators).
+std::map<std::string, Entry> registry() {
+  std::lock_guard<std::mutex> lock(registry_mutex());
+  return registry_table();
+}
 }  // namespace
+
+void register_integrator(const std::string& name, const std::string& summary, IntegratorFactory factory,
+                         const std::string& origin) {
+  if (name.empty()) throw std::invalid_argument("register_integrator: empty integrator name");
+  if (!factory) throw std::invalid_argument("register_integrator: integrator '" + name + "' has no factory");
+  std::lock_guard<std::mutex> lock(registry_mutex());
+  auto& r = registry_table();
+  if (r.count(name))
+    throw std::invalid_argument("register_integrator: integrator '" + name + "' is already registered" +
+                                (r[name].origin.empty() ? std::string(" (built-in)") : " by " + r[name].origin));
+  r[name] = Entry{std::move(factory), summary, origin};
+}
+
+bool unregister_integrator(const std::string& name) {
+  std::lock_guard<std::mutex> lock(registry_mutex());
+  return registry_table().erase(name) > 0;
+}
+
+std::string integrator_origin(const std::string& name) {
+  std::lock_guard<std::mutex> lock(registry_mutex());
+  const auto& r = registry_table();
+  const auto it = r.find(name);
+  return it == r.end() ? std::string() : it->second.origin;
+}
 
 std::vector<std::string> integrator_names() {
   std::vector<std::string> names;
@@ -70,8 +106,9 @@ std::vector<std::pair<std::string, std::string>> settings_understood_by(
 }
 
 std::unique_ptr<Integrator> make_integrator(IntegratorSettings& settings, double dt) {
-  const auto it = registry().find(settings.name());
-  if (it == registry().end()) {
+  const auto r = registry();
+  const auto it = r.find(settings.name());
+  if (it == r.end()) {
     std::string names;
     for (const auto& n : integrator_names()) names += (names.empty() ? "" : ", ") + n;
     throw std::invalid_argument("unknown integrator '" + settings.name() + "' (see the list below)\navailable: " + names);

@@ -4,6 +4,7 @@
 
 #include "integrators/integrator.hpp"
 
+#include <functional>
 #include <memory>
 #include <string>
 #include <utility>
@@ -30,6 +31,15 @@ std::vector<std::string> integrator_names();
 // integrator.cpp (static self-registration would be dropped by the linker from a static library).
 std::vector<std::pair<std::string, std::string>> integrator_catalogue();
 
-using IntegratorFactory = std::unique_ptr<Integrator> (*)(IntegratorSettings& settings, double dt);
+using IntegratorFactory = std::function<std::unique_ptr<Integrator>(IntegratorSettings& settings, double dt)>;
+
+// Adds an integrator by name (TEMP shim of the open registry: same signatures as the public API).
+// Throws std::invalid_argument if the name is empty or already registered.
+void register_integrator(const std::string& name, const std::string& summary, IntegratorFactory factory,
+                         const std::string& origin = "");
+// Removes a registered integrator; false if there was none of that name.
+bool unregister_integrator(const std::string& name);
+// Where an integrator comes from ("" for built-ins, e.g. a plugin path or "python:MODULE.CLASS").
+std::string integrator_origin(const std::string& name);
 
 }  // namespace shelldyn
