@@ -9,9 +9,9 @@
 #include "lib/openmp_wait_policy.hpp"  // passive OpenMP waiting in every app (linked into each of them)
 #ifdef SHELLDYN_HAVE_MPI
 #include "integrators/runs/mpi_executor.hpp"
+#endif
 #include "integrators/checkpoint/checkpoint.hpp"
 #include "lib/state_output.hpp"
-#endif
 
 
 #include <spawn.h>
