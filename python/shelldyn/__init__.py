@@ -185,10 +185,18 @@ def run(case, integrator=None, settings=None, dt=None, t_end=None, output_interv
 class CompareResult:
     """A comparison: ``rows`` (one dict per run: label, integrator, dt, status, energy_error,
     displacement_error, summary, out_dir), ``reference``, ``summary_csv``/``summary_md`` paths and
-    ``history(label)`` (that run's history.csv as arrays)."""
+    ``history(label)`` / ``run_json(label)`` (that run's history.csv as arrays, its run.json as a dict)."""
 
     def __init__(self, d):
         self.__dict__.update(d)
+        for row in self.rows:  # the CPU and wall time of a run are those its run.json records
+            path = os.path.join(row["out_dir"], "run.json")
+            if row["summary"] is not None and os.path.exists(path):
+                with open(path) as f:
+                    rs = json.load(f).get("summary", {})
+                for key in ("cpu_s", "wall_s"):
+                    if key in rs:
+                        row["summary"][key] = rs[key]
 
     def row(self, label):
         for r in self.rows:
@@ -198,6 +206,10 @@ class CompareResult:
 
     def history(self, label):
         return read_history(os.path.join(self.row(label)["out_dir"], "history.csv"))
+
+    def run_json(self, label):
+        with open(os.path.join(self.row(label)["out_dir"], "run.json")) as f:
+            return json.load(f)
 
     def __repr__(self):
         return "CompareResult(%d runs, reference %r)" % (len(self.rows), self.reference)
