@@ -45,7 +45,7 @@ for name, pts in points.items():
     pts = np.array(sorted(pts))
     ax.loglog(pts[:, 0], pts[:, 1], "o-", label=name)
 ax.set_xlabel("CPU time [s]")
-ax.set_ylabel("max displacement error vs em-galpha dt = 2.5e-5 [m]")
+ax.set_ylabel("max displacement error vs %s [m]" % r.reference)
 ax.set_title("flying plate, t in [0, %g] s" % args.t_end)
 ax.legend()
 fig.tight_layout()

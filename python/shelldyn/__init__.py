@@ -167,6 +167,11 @@ def run(case, integrator=None, settings=None, dt=None, t_end=None, output_interv
     lines, a callable receives each line, None is silent.
     """
     c = _as_case(case)
+    for key, value, ok in (("dt", dt, lambda x: x > 0), ("t_end", t_end, lambda x: x >= 0),
+                           ("output_interval", output_interval, lambda x: x > 0)):
+        if value is not None and not (isinstance(value, (int, float)) and ok(value) and value < 1e15):
+            raise InputError("%s = %r: must be a number %s (e.g. %s=%s)" % (
+                key, value, "> 0" if key != "t_end" else ">= 0", key, {"dt": "1e-3", "t_end": "2.0"}.get(key, "0.01")))
     keep = out_dir is not None
     folder = os.fspath(out_dir) if keep else tempfile.mkdtemp(prefix="shelldyn-run-")
     if vtu_every is None:

@@ -273,7 +273,16 @@ py::dict run_case(PyCase& c, const std::string& integrator, const py::object& se
   ro.integrator = integrator;
   ro.settings = settings_pairs(settings);
   for (const auto& kv : ro.settings) ro.overrides.emplace_back("--set", kv.first + "=" + kv.second);
-  if (dt > 0) ro.overrides.emplace_back("--dt", std::to_string(dt));
+  const auto number = [](double x) {
+    std::ostringstream os;
+    os.precision(17);
+    os << x;
+    return os.str();
+  };
+  if (!integrator.empty()) ro.overrides.emplace_back("--integrator", integrator);
+  if (dt > 0) ro.overrides.emplace_back("--dt", number(dt));
+  if (t_end >= 0) ro.overrides.emplace_back("--t-end", number(t_end));
+  if (output_interval > 0) ro.overrides.emplace_back("--output-every", number(output_interval));
   CaseSpec spec = c.spec;
   Log log(progress);
   py::dict out;

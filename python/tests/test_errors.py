@@ -43,7 +43,9 @@ def test_unknown_integrator_and_setting(shelldyn, tmp_path):
         shelldyn.run("flying-plate", "no-such-scheme", t_end=0.01)
     with pytest.raises(shelldyn.InputError, match="rho_inf"):
         shelldyn.run("flying-plate", "em-galpha", settings={"rho_inf": "abc"}, t_end=0.01)
-    assert not (tmp_path / "x").exists()
+    with pytest.raises(shelldyn.InputError, match="dt = -0.001: must be a number > 0"):
+        shelldyn.run("flying-plate", "em-galpha", dt=-1e-3, t_end=0.01, out_dir=tmp_path / "x")
+    assert not (tmp_path / "x").exists()  # rejected before any folder is made
 
 
 def test_bad_arrays(shelldyn):
