@@ -17,9 +17,12 @@
 // (lib/linear_solver.cpp limit_blas_threads()), but OpenBLAS's pthread build starts its thread pool when it is
 // loaded, and the pool's thread spins (sched_yield) for a while after start-up: ~2 % of a 5 s run's CPU on the
 // flying plate. With the variable set, no pool is created.
+//
+// Never in a library loaded into another program (the Python module, python/CMakeLists.txt): re-executing
+// the host process would restart it. Such builds define SHELLDYN_NO_OPENMP_REEXEC.
 #pragma once
 
-#if defined(__linux__) && defined(__GNUC__)
+#if defined(__linux__) && defined(__GNUC__) && !defined(SHELLDYN_NO_OPENMP_REEXEC)
 #include <cstdlib>
 #include <unistd.h>
 

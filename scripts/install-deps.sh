@@ -20,6 +20,8 @@ PACKAGES=(
   libbenchmark-dev                     # performance programs
   python3 python3-meshio               # VTU round-trip check in the test suite
   python3-matplotlib                   # plots of the apps and `shelldyn compare` (scripts/plot_*.py)
+  pybind11-dev python3-dev             # the shelldyn Python module (python/, SHELLDYN_WITH_PYTHON)
+  python3-numpy python3-scipy python3-pytest   # its arrays, sparse matrices and tests
 )
 # Not listed (opt-in tools): clang-14 libclang-rt-14-dev for scripts/fuzz.sh (libFuzzer); .ci/run
 # installs them itself when SHELLDYN_CI_SANITIZE=1.
