@@ -7,6 +7,8 @@
 #include "integrators/runs/registry.hpp"
 #include "integrators/runs/study.hpp"
 
+#include "lib/yaml_checks.hpp"
+
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
@@ -25,21 +27,8 @@ namespace {
 
 using number_text::num;
 
-std::string join(const std::vector<std::string>& items) {
-  std::string out;
-  for (size_t k = 0; k < items.size(); ++k) out += (k ? ", " : "") + items[k];
-  return out;
-}
-
-std::string node_kind(const YAML::Node& n) {
-  switch (n.Type()) {
-    case YAML::NodeType::Null: return "null (empty value)";
-    case YAML::NodeType::Scalar: return "scalar '" + n.Scalar() + "'";
-    case YAML::NodeType::Sequence: return "list";
-    case YAML::NodeType::Map: return "mapping";
-    default: return "undefined value";
-  }
-}
+using yaml_checks::join;
+using yaml_checks::node_kind;
 
 bool is_plain_name(const std::string& s) {
   if (s.empty() || s[0] == '.' || s[0] == '-') return false;
@@ -61,20 +50,8 @@ class Parser {
 
   void check_keys(const YAML::Node& map, const std::string& path, const std::vector<std::string>& allowed,
                   const std::vector<std::string>& required) const {
-    if (!map.IsMap()) fail(map, path, "expected a mapping (key: value), got a " + node_kind(map));
-    std::set<std::string> seen;
-    for (auto it = map.begin(); it != map.end(); ++it) {
-      if (!it->first.IsScalar()) fail(it->first, path, "keys must be plain names");
-      const std::string key = it->first.Scalar();
-      const std::string sub = path.empty() ? key : path + "." + key;
-      if (std::find(allowed.begin(), allowed.end(), key) == allowed.end())
-        fail(it->first, sub, "unknown key '" + key + "' (allowed here: " + join(allowed) + ")");
-      if (!seen.insert(key).second) fail(it->first, sub, "duplicate key '" + key + "' (keep only one)");
-    }
-    for (const auto& key : required)
-      if (!seen.count(key))
-        fail(map, path.empty() ? key : path + "." + key,
-             "missing required key '" + key + "' (add it" + (path.empty() ? "" : " under '" + path + "'") + ")");
+    yaml_checks::check_keys(map, path, allowed, required,
+                            [this](const YAML::Node& at, const std::string& p, const std::string& r) { fail(at, p, r); });
   }
 
   double positive(const YAML::Node& n, const std::string& path) const {
