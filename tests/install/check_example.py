@@ -2,18 +2,37 @@
 """Checks of tests/install/run_example_test.sh: COMPARE_DIR has complete rows em-galpha and velocity-verlet; their
 history.csv have the same columns; the velocity-verlet run.json names the plugin; IN_TREE_DIR/history.csv (the
 same source compiled into a test program) equals the plugin's in every column but wall_s.
-usage: check_example.py COMPARE_DIR IN_TREE_DIR PLUGIN.so"""
+With --study STUDY_DIR: study.csv has complete window rows of em-galpha and velocity-verlet, each with a finite
+displacement error against the reference run.
+usage: check_example.py COMPARE_DIR IN_TREE_DIR PLUGIN.so | check_example.py --study STUDY_DIR"""
 import csv
 import json
+import math
 import os
 import sys
-
-cmp_dir, in_tree, plugin = sys.argv[1:4]
 
 
 def fail(msg):
     print("FAIL: " + msg)
     sys.exit(1)
+
+
+if sys.argv[1] == "--study":
+    with open(os.path.join(sys.argv[2], "study.csv"), newline="") as f:
+        rows = [r for r in csv.DictReader(f) if r["group"] == "window" and r["kind"] != "reference"]
+    for name in ("em-galpha", "velocity-verlet"):
+        mine = [r for r in rows if r["integrator"] == name]
+        if not mine or any(r["status"] != "complete" for r in mine):
+            fail(f"study.csv: window rows of {name} missing or not complete: {mine}")
+        bad = [r["label"] for r in mine if not math.isfinite(float(r["displacement_error"]))]
+        if bad:
+            fail(f"study.csv: no displacement error for {bad}")
+    vv = [r for r in rows if r["integrator"] == "velocity-verlet"]
+    print(f"example plugin in a study file: {len(rows)} window rows complete, velocity-verlet "
+          f"displacement error {float(vv[0]['displacement_error']):.3g}")
+    sys.exit(0)
+
+cmp_dir, in_tree, plugin = sys.argv[1:4]
 
 
 def table(path):
