@@ -698,8 +698,12 @@ RunSummary run_dynamic(Problem& problem, const RunOptions& o) {
     if (line_open) *o.log << std::endl;  // end the in-place status line before the error message
     const std::string json_error = write_status(std::string("incomplete: ") + blame + e.what(), true);
     if (!json_error.empty()) throw std::runtime_error(blame + e.what() + "; " + json_error);
-    if (!blame.empty()) throw std::runtime_error(blame + e.what());  // names the plugin (integrators/runs/plugin.hpp)
-    throw;
+    if (blame.empty()) throw;
+    // Names the plugin (integrators/runs/plugin.hpp) and keeps the kind of failure: a step that could not be
+    // completed stays a StepFailure and bad input stays std::invalid_argument, as for a built-in.
+    if (dynamic_cast<const StepFailure*>(&e)) throw StepFailure(blame + e.what());
+    if (dynamic_cast<const std::invalid_argument*>(&e)) throw std::invalid_argument(blame + e.what());
+    throw std::runtime_error(blame + e.what());
   } catch (...) {  // a plugin may throw anything
     const std::string what = blame + "threw a non-standard exception";
     write_status("incomplete: " + what, true);

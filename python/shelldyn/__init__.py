@@ -42,15 +42,15 @@ from ._shelldyn import (  # noqa: F401  (re-exported)
     mechanical_energy_drift,
     read_history,
     run_script,
-    study_preset,
-    study_presets,
+    Study,
 )
 from . import _shelldyn
 
 __all__ = [
     "Case", "Chart", "Charts", "Error", "InputError", "Integrator", "IntegratorSettings", "RunResult", "RunStopped",
     "State", "StepFailure", "System", "compare", "integrator_catalogue", "integrator_names", "load_case",
-    "read_history", "register_integrator", "run", "study", "study_preset", "study_presets", "unregister_integrator",
+    "read_history", "register_integrator", "run", "study", "Study", "study_files", "load_study", "load_study_from_string",
+    "study_from_string", "unregister_integrator",
 ]
 
 
@@ -237,22 +237,88 @@ def compare(case, integrators, out_dir, dts=(), rtols=(), t_end=None, output_int
     return CompareResult(d)
 
 
-def study(benchmark, out_dir, case=None, groups=("window", "full"), rerun=False, jobs=2, max_wall_per_run=0.0,
-          plots=False, progress=None, **preset):
-    """``shelldyn study``: the work-precision sweep (group "window") and full-duration runs (group
-    "full") of a benchmark. Any key of study_preset(benchmark) can be overridden, e.g.
-    fixed_specs=["em-galpha", "newmark", "verlet"], dts=[...], window_t_end=0.2. Returns a dict with
-    ``rows`` (one per run: group, label, kind, dt, status, cpu_s, energy_error, displacement_error, ...),
-    counts and the study.csv/study.md paths; plots=True runs scripts/plot_study.py."""
-    p = {"name": benchmark}
-    p.update(preset)
-    if case is None:
-        case = _resolve_case(study_preset(benchmark)["case_file"])
-    d = _shelldyn._study(p, _resolve_case(case), os.fspath(out_dir), list(groups), rerun, jobs,
-                         max_wall_per_run, _progress_sink(progress), "python: shelldyn.study(%r)" % benchmark)
-    if plots:
+def _installed_studies():
+    """<prefix>/share/shelldyn/studies/*.yaml of an installed package (see _installed_case)."""
+    share = os.path.normpath(os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "..", "..", "share",
+                                          "shelldyn", "studies"))
+    if not os.path.isdir(share):
+        return {}
+    return {f[:-5]: os.path.join(share, f) for f in sorted(os.listdir(share)) if f.endswith(".yaml")}
+
+
+def study_files():
+    """The shipped study files (docs/reference/study-files.md) as a dict name -> path, e.g.
+    {"flying-plate": ".../apps/studies/flying-plate.yaml", ...}: the studies of ``shelldyn study NAME``."""
+    return _shelldyn._study_files() or _installed_studies()
+
+
+def load_study(name_or_path):
+    """Reads and validates a study file: a shipped study by name (study_files()) or the path of a study file
+    of your own. Returns a Study (name, case_file, methods, window_t_end, dts, rtols, reference, ...;
+    add_method(spec) adds a method). Errors raise InputError with the file, the line and the key."""
+    name_or_path = os.fspath(name_or_path)
+    shipped = study_files()
+    if name_or_path in shipped:
+        return _shelldyn._load_study_file(shipped[name_or_path])
+    if os.path.exists(name_or_path):
+        return _shelldyn._load_study_file(name_or_path)
+    raise InputError("study: unknown benchmark or study file '%s' (shipped: %s; or the path of a study file)"
+                     % (name_or_path, ", ".join(shipped) or "none found"))
+
+
+def load_study_from_string(text, base_dir=".", source="<string>"):
+    """A study from YAML text (the study-file format); a relative ``case:`` is taken relative to base_dir,
+    and error messages name ``source``. Returns a Study."""
+    return _shelldyn._load_study_from_string(text, source, os.fspath(base_dir))
+
+
+def _study_case(s, case):
+    """The study's case, as ``shelldyn study`` picks it: case=..., else the study file's case: next to the
+    file, else the shipped case of that file name."""
+    if case is not None:
+        return case.path if isinstance(case, Case) else _resolve_case(case)
+    if s.case_path:
+        return s.case_path
+    try:
+        return _resolve_case(os.path.basename(s.case_file))
+    except Error as e:
+        raise InputError("%s: %s" % (s.source or s.name, e))
+
+
+def study(study, out_dir=None, add_methods=(), case=None, groups=None, rerun=False, jobs=2, max_wall_per_run=0.0,
+          max_steps_per_run=0, dry_run=False, plots=False, progress=None):
+    """``shelldyn study``: the work-precision sweep (group "window") and full-duration runs (group "full")
+    of a study: a shipped study by name (study_files()), the path of a study file, or a Study
+    (load_study / load_study_from_string). add_methods: specs NAME[:KEY=VALUE...] added as
+    ``--add-method`` does (any registered integrator, Python ones included); case: another case file for
+    the same methods and sweeps; out_dir: default results/<name>/study; groups: e.g. ["window"] (default:
+    every group the study has); dry_run=True lists the runs and runs nothing. Returns a dict with
+    ``rows`` (one per run: group, label, kind, dt, rtol,
+    status, cpu_s, energy_error, displacement_error, ...), the counts ran/skipped/failed/stopped and the
+    study.csv/study.md paths; plots=True runs scripts/plot_study.py."""
+    s = study if isinstance(study, Study) else load_study(study)
+    if isinstance(add_methods, str):
+        add_methods = add_methods.split(",")
+    if add_methods:
+        if isinstance(study, Study):  # do not change the caller's Study
+            s = s.copy()
+        for spec in add_methods:
+            s.add_method(spec)
+    if out_dir is None:
+        out_dir = os.path.join("results", s.name, "study")
+    if isinstance(groups, str):
+        groups = [groups]
+    d = _shelldyn._study(s, _study_case(s, case), os.fspath(out_dir), list(groups or ()), rerun, dry_run, jobs,
+                         max_wall_per_run, max_steps_per_run, _progress_sink(progress),
+                         "python: shelldyn.study(%r)" % (s.source or s.name))
+    if plots and not dry_run:
         run_script("plot_study.py", [os.fspath(out_dir)])
     return d
+
+
+def study_from_string(text, out_dir=None, base_dir=".", source="<string>", **kwargs):
+    """study() of a study given as YAML text (load_study_from_string(text, base_dir, source))."""
+    return study(load_study_from_string(text, base_dir, source), out_dir, **kwargs)
 
 
 def _register_verlet_cpp(name="verlet-cpp"):

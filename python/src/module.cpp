@@ -30,8 +30,8 @@
 #include "lib/run_info.hpp"
 
 #include <chrono>
+#include <cmath>
 #include <filesystem>
-#include <set>
 #include <sstream>
 #include <streambuf>
 
@@ -892,70 +892,105 @@ void bind_all(py::module_& m) {
       py::arg("vtu_every"), py::arg("jobs"), py::arg("threads"), py::arg("out_dir"), py::arg("reference"), py::arg("resume"),
       py::arg("progress"), py::arg("command"));
 
-  m.def("study_presets", [] {
-    std::vector<std::string> names;
-    for (const auto& p : study_presets()) names.push_back(p.name);
-    return names;
-  });
+  // --- studies (integrators/runs/study.hpp; files: docs/reference/study-files.md) ---------------------
   m.def(
-      "study_preset",
-      [](const std::string& name) {
-        const StudyPreset p = study_preset(name);
+      "_study_files",
+      [] {
         py::dict d;
-        d["name"] = p.name;
-        d["case_file"] = p.case_file;
-        d["window_t_end"] = p.window_t_end;
-        d["window_output"] = p.window_output;
-        d["fixed_specs"] = p.fixed_specs;
-        d["dts"] = p.dts;
-        d["adaptive_specs"] = p.adaptive_specs;
-        d["rtols"] = p.rtols;
-        d["reference_spec"] = p.reference_spec;
-        d["full_dt"] = p.full_dt;
-        d["full_output"] = p.full_output;
-        d["full_baselines"] = p.full_baselines;
-        d["note"] = p.note;
+        for (const auto& [name, path] : app::shipped_study_files()) d[py::str(name)] = path;
         return d;
       },
-      py::arg("name"), "The methods and sweeps of `shelldyn study NAME` as a dict (edit it and pass it to study())");
+      "The shipped study files (apps/studies/*.yaml or <prefix>/share/shelldyn/studies): name -> path");
+  py::class_<StudyPreset>(m, "Study",
+                          "A study file (docs/reference/study-files.md), read and validated: the case, the methods, the "
+                          "window's sweeps and reference, the full-duration runs. add_method(spec) adds a method.")
+      .def_readonly("name", &StudyPreset::name)
+      .def_readonly("source", &StudyPreset::source)
+      .def_readonly("case_file", &StudyPreset::case_file)
+      .def_readonly("case_path", &StudyPreset::case_path)
+      .def_readonly("note", &StudyPreset::note)
+      .def_readonly("has_window", &StudyPreset::has_window)
+      .def_readonly("window_t_end", &StudyPreset::window_t_end)
+      .def_readonly("window_output", &StudyPreset::window_output)
+      .def_readonly("dts", &StudyPreset::dts)
+      .def_readonly("rtols", &StudyPreset::rtols)
+      .def_readonly("reference", &StudyPreset::reference_spec)
+      .def_readonly("has_full", &StudyPreset::has_full)
+      .def_readonly("full_t_end", &StudyPreset::full_t_end)
+      .def_readonly("full_dt", &StudyPreset::full_dt)
+      .def_readonly("full_output", &StudyPreset::full_output)
+      .def_readonly("full_runs", &StudyPreset::full_baselines)
+      .def_readonly("headline", &StudyPreset::headline)
+      .def_property_readonly(
+          "methods",
+          [](const StudyPreset& p) {
+            py::list l;
+            for (const auto& mth : p.methods) {
+              py::dict d;
+              d["spec"] = mth.spec;
+              d["integrator"] = mth.integrator;
+              d["adaptive"] = mth.adaptive;
+              d["sweep"] = mth.sweep;
+              d["window"] = mth.window;
+              d["full"] = mth.full;
+              d["where"] = mth.where;
+              l.append(d);
+            }
+            return l;
+          },
+          "One dict per method, in file order: spec, integrator, adaptive, sweep (its dt or rtol values), window, full, where")
+      .def(
+          "add_method",
+          [](StudyPreset& p, const std::string& spec) { add_study_method(p, spec, "add_method('" + spec + "')"); },
+          py::arg("spec"),
+          "Adds a method NAME[:KEY=VALUE...] (any registered integrator, Python ones included), swept over the window's "
+          "default dt or rtol list and (fixed-step) run over the full duration, as `shelldyn study --add-method`")
+      .def("copy", [](const StudyPreset& p) { return p; }, "An independent copy (add_method on it leaves this one as it is)")
+      .def("__repr__", [](const StudyPreset& p) {
+        return "Study(" + p.name + ", " + std::to_string(p.methods.size()) + " methods, case " + p.case_file + ")";
+      });
+  m.def(
+      "_load_study_file", [](const std::string& path) { return input_errors([&] { return load_study_file(path); }); },
+      py::arg("path"));
+  m.def(
+      "_load_study_from_string",
+      [](const std::string& text, const std::string& source, const std::string& base_dir) {
+        return input_errors([&] { return load_study_from_string(text, source, base_dir); });
+      },
+      py::arg("text"), py::arg("source"), py::arg("base_dir"));
   m.def(
       "_study",
-      [](const py::dict& preset, const std::string& case_path, const std::string& out_dir, const std::vector<std::string>& groups,
-         bool rerun, int jobs, double max_wall_per_run, const py::object& progress, const std::string& command) {
-        StudyOptions so;
-        StudyPreset& p = so.preset;
-        p = study_preset(preset["name"].cast<std::string>());
-        for (auto item : preset) {
-          const std::string k = py::str(item.first);
-          static const std::set<std::string> known = {"name", "case_file", "window_t_end", "window_output", "fixed_specs", "dts",
-                                                      "adaptive_specs", "rtols", "reference_spec", "full_dt", "full_output",
-                                                      "full_baselines", "note"};
-          if (!known.count(k)) throw std::invalid_argument("study preset: unknown key '" + k + "'");
+      [](const StudyPreset& preset, const std::string& case_path, const std::string& out_dir, const std::vector<std::string>& groups,
+         bool rerun, bool dry_run, int jobs, double max_wall_per_run, long long max_steps_per_run, const py::object& progress,
+         const std::string& command) {
+        // The checks of `shelldyn study` (apps/shelldyn.cpp, run_study_command), with the keyword names.
+        if (jobs < 1) throw std::invalid_argument("study: jobs must be >= 1 (got " + std::to_string(jobs) + ")");
+        if (!(max_wall_per_run >= 0.0) || !std::isfinite(max_wall_per_run) || max_steps_per_run < 0)
+          throw std::invalid_argument("study: max_wall_per_run and max_steps_per_run must be >= 0 (0: no budget)");
+        for (const auto& g : groups) {
+          if (g != "window" && g != "full")
+            throw std::invalid_argument("study: groups must be 'window' and/or 'full' (got '" + g + "')");
+          if ((g == "window" && !preset.has_window) || (g == "full" && !preset.has_full))
+            throw std::invalid_argument("study: groups=['" + g + "']: " + (preset.source.empty() ? preset.name : preset.source) +
+                                        " has no " + g + ": section");
         }
-        set_if(preset, "window_t_end", p.window_t_end);
-        set_if(preset, "window_output", p.window_output);
-        set_if(preset, "fixed_specs", p.fixed_specs);
-        set_if(preset, "dts", p.dts);
-        set_if(preset, "adaptive_specs", p.adaptive_specs);
-        set_if(preset, "rtols", p.rtols);
-        set_if(preset, "reference_spec", p.reference_spec);
-        set_if(preset, "full_dt", p.full_dt);
-        set_if(preset, "full_output", p.full_output);
-        set_if(preset, "full_baselines", p.full_baselines);
-        set_if(preset, "note", p.note);
-        so.case_path = case_path.empty() ? app::find_case_file(p.case_file) : resolve_case_path(case_path);
+        StudyOptions so;
+        so.preset = preset;
+        so.case_path = case_path;
         so.out_dir = out_dir;
-        so.groups = groups;
+        if (!groups.empty()) so.groups = groups;
         so.rerun = rerun;
+        so.dry_run = dry_run;
         so.execution.jobs = jobs;
         so.max_wall_per_run = max_wall_per_run;
+        so.max_steps_per_run = max_steps_per_run;
         so.command = command;
         Log log(progress);
         so.log = log.get();
         StudyResult r;
         {
           py::gil_scoped_release release;
-          app::check_output_folder(so.out_dir);
+          if (!dry_run) app::check_output_folder(so.out_dir);
           r = run_study(so);
         }
         py::dict d;
@@ -971,8 +1006,8 @@ void bind_all(py::module_& m) {
         d["out_dir"] = out_dir;
         return d;
       },
-      py::arg("preset"), py::arg("case"), py::arg("out_dir"), py::arg("groups"), py::arg("rerun"), py::arg("jobs"),
-      py::arg("max_wall_per_run"), py::arg("progress"), py::arg("command"));
+      py::arg("study"), py::arg("case"), py::arg("out_dir"), py::arg("groups"), py::arg("rerun"), py::arg("dry_run"),
+      py::arg("jobs"), py::arg("max_wall_per_run"), py::arg("max_steps_per_run"), py::arg("progress"), py::arg("command"));
 
   // The same evaluation timed in C++ (preallocated F and K, no Python in the loop): the baseline of the
   // Python call-boundary measurement (python/examples/bench_internal.py).

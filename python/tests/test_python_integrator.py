@@ -73,15 +73,34 @@ def test_compare_runs_python_beside_builtins(registered, tmp_path):
     assert "1.1" in json.dumps(rj)
 
 
+STUDY = """
+name: py-verlet
+case: flying-plate.yaml     # not next to base_dir: the shipped case of that name
+window:
+  t_end: 0.01
+  output_interval: 0.005
+  dt: [5e-5, 2.5e-5]
+  reference: em-galpha:dt=1.25e-5
+methods:
+  - em-galpha
+"""
+
+
 def test_study_with_a_python_method(registered, tmp_path):
     sd = registered
-    preset = sd.study_preset("flying-plate")
-    assert "em-galpha" in preset["fixed_specs"]
-    d = sd.study("flying-plate", tmp_path / "study", groups=["window"], window_t_end=0.01, window_output=0.005,
-                 fixed_specs=["em-galpha", "verlet"], dts=[5e-5, 2.5e-5], adaptive_specs=[], rtols=[],
-                 reference_spec="em-galpha:dt=1.25e-5")
+    shipped = sd.study_files()
+    assert {"flying-plate", "cylindrical-panel", "pinched-hemisphere"} <= set(shipped)
+    fp = sd.load_study("flying-plate")
+    assert fp.source == shipped["flying-plate"] and "em-galpha" in [m["integrator"] for m in fp.methods]
+    # a Python-registered name is a method like a built-in: in a study's methods: list ...
+    s = sd.load_study_from_string(STUDY.replace("  - em-galpha\n", "  - em-galpha\n  - verlet\n"), base_dir=tmp_path)
+    assert [(m["integrator"], m["adaptive"]) for m in s.methods] == [("em-galpha", False), ("verlet", False)]
+    # ... and added by name (add_methods, as `shelldyn study --add-method`); the given Study is left unchanged
+    base = sd.load_study_from_string(STUDY, base_dir=tmp_path)
+    d = sd.study(base, tmp_path / "study", add_methods=["verlet"], groups=["window"])
+    assert [m["integrator"] for m in base.methods] == ["em-galpha"]
     rows = {(r["label"]): r for r in d["rows"]}
-    assert d["failed"] == 0 and d["ran"] == 5
+    assert d["failed"] == 0 and d["ran"] == 5, sorted(rows)
     for label in ("verlet_dt=5e-05", "verlet_dt=2.5e-05"):
         assert label in rows, sorted(rows)
         r = rows[label]
@@ -91,3 +110,19 @@ def test_study_with_a_python_method(registered, tmp_path):
     ratio = rows["verlet_dt=5e-05"]["displacement_error"] / rows["verlet_dt=2.5e-05"]["displacement_error"]
     assert 2.5 < ratio < 6, ratio
     assert os.path.exists(d["study_csv"]) and "verlet" in open(d["study_md"]).read()
+    # the same study from the text, with the method added by name: every run is kept from the first call
+    d2 = sd.study_from_string(STUDY, tmp_path / "study", base_dir=tmp_path, add_methods="verlet", groups=["window"])
+    assert d2["ran"] == 0 and d2["skipped"] == 5 and d2["failed"] == 0
+
+
+def test_study_errors(registered, tmp_path):
+    sd = registered
+    with pytest.raises(sd.InputError, match="unknown benchmark or study file 'flying-plat'.*flying-plate"):
+        sd.load_study("flying-plat")
+    with pytest.raises(sd.InputError, match=r"s\.yaml:\d+: methods\[1\]: unknown integrator 'verlett'"):
+        sd.load_study_from_string(STUDY + "  - verlett\n", base_dir=tmp_path, source="s.yaml")
+    with pytest.raises(sd.InputError, match="add_method\('nosuch'\).*unknown integrator 'nosuch'"):
+        sd.study(sd.load_study_from_string(STUDY, base_dir=tmp_path), tmp_path / "x", add_methods=["nosuch"])
+    with pytest.raises(sd.InputError, match="has no full: section"):
+        sd.study_from_string(STUDY, tmp_path / "y", base_dir=tmp_path, groups=["full"])
+    assert not os.path.exists(tmp_path / "x") and not os.path.exists(tmp_path / "y")
