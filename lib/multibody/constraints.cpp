@@ -122,11 +122,13 @@ class Coincidence : public Constraint {
   std::vector<int> unknowns_;
 };
 
-// ---- revolute joint (§4.3): coincidence + two bilinear axis conditions (quadratic) ----------------------
-class Revolute : public Constraint {
+// ---- coincidence + two bilinear axis conditions (quadratic): a = b, e·f = 0, e·h = 0 --------------------
+// The revolute joint (§4.3: e the axis in one body, f, h normals to it in the other) and the rigid connection of
+// a unit director p to a body (§4.2, aligned form: e = p, f, h the body vectors normal to p's body components).
+class AxisCondition : public Constraint {
  public:
-  Revolute(std::string name, PointMap a, PointMap b, PointMap e, PointMap f, PointMap h)
-      : Constraint(std::move(name), "revolute joint"),
+  AxisCondition(std::string name, std::string kind_label, PointMap a, PointMap b, PointMap e, PointMap f, PointMap h)
+      : Constraint(std::move(name), std::move(kind_label)),
         a_(a),
         b_(b),
         e_(e),
@@ -169,52 +171,6 @@ class Revolute : public Constraint {
 
  private:
   PointMap a_, b_, e_, f_, h_;
-  std::vector<int> unknowns_;
-};
-
-// ---- rigid connection with an aligned (unit) director (§4.2; quadratic) ---------------------------------
-class AlignedConnection : public Constraint {
- public:
-  AlignedConnection(std::string name, PointMap x, PointMap p, int body, const Vec3& X, const Vec3& b,
-                    const Vec3& c)
-      : Constraint(std::move(name), "rigid connection"),
-        x_(x),
-        y_(PointMap::body_point(body, X)),
-        p_(p),
-        b_(PointMap::body_vector(body, b)),
-        c_(PointMap::body_vector(body, c)),
-        unknowns_(unknowns_of({&x_, &y_, &p_, &b_, &c_})) {}
-  int size() const override { return 5; }
-  ConstraintKind kind() const override { return ConstraintKind::quadratic; }
-  std::vector<int> unknowns() const override { return unknowns_; }
-  Eigen::VectorXd g(const Eigen::VectorXd& q, double) const override {
-    Eigen::VectorXd r(5);
-    r.head<3>() = x_(q) - y_(q);
-    const Vec3 p = p_(q);
-    r(3) = p.dot(b_(q));
-    r(4) = p.dot(c_(q));
-    return r;
-  }
-  void jacobian(const Eigen::VectorXd& q, double, std::vector<Triplet>& out) const override {
-    x_.add_block(0, 1.0, out);
-    y_.add_block(0, -1.0, out);
-    const Vec3 p = p_(q), b = b_(q), c = c_(q);
-    p_.add_row(3, b, 1.0, out);
-    b_.add_row(3, p, 1.0, out);
-    p_.add_row(4, c, 1.0, out);
-    c_.add_row(4, p, 1.0, out);
-  }
-  void hessian_contraction(const Eigen::VectorXd&, double, const Eigen::VectorXd& lam,
-                           std::vector<Triplet>& out) const override {
-    const Eigen::Matrix3d I = Eigen::Matrix3d::Identity();
-    p_.add_outer(b_, I, lam(3), out);
-    b_.add_outer(p_, I, lam(3), out);
-    p_.add_outer(c_, I, lam(4), out);
-    c_.add_outer(p_, I, lam(4), out);
-  }
-
- private:
-  PointMap x_, y_, p_, b_, c_;
   std::vector<int> unknowns_;
 };
 
@@ -529,7 +485,7 @@ std::unique_ptr<Constraint> fixed_point(std::string name, PointMap a, const Vec3
 
 std::unique_ptr<Constraint> revolute_joint(std::string name, PointMap a, PointMap b, PointMap axis_a,
                                            PointMap normal1_b, PointMap normal2_b) {
-  return std::make_unique<Revolute>(std::move(name), a, b, axis_a, normal1_b, normal2_b);
+  return std::make_unique<AxisCondition>(std::move(name), "revolute joint", a, b, axis_a, normal1_b, normal2_b);
 }
 
 std::unique_ptr<Constraint> rigid_connection(std::string name, PointMap x, PointMap p, int body_base,
@@ -545,7 +501,8 @@ std::unique_ptr<Constraint> rigid_connection(std::string name, PointMap x, Point
     Eigen::Index k;
     a.cwiseAbs().minCoeff(&k);
     const Vec3 b = a.cross(Vec3::Unit(k)).normalized(), c = a.cross(b);
-    return std::make_unique<AlignedConnection>(std::move(name), x, p, body_base, X, b, c);
+    return std::make_unique<AxisCondition>(std::move(name), "rigid connection", x, PointMap::body_point(body_base, X), p,
+                                           PointMap::body_vector(body_base, b), PointMap::body_vector(body_base, c));
   }
   return std::make_unique<Coincidence>(
       std::move(name), "rigid connection",
