@@ -1,5 +1,5 @@
 #include "apps/app_common.hpp"
-#include "lib/result_folder.hpp"
+#include "lib/io/result_folder.hpp"
 
 #include "integrators/runs/case_integrator.hpp"
 #include "integrators/runs/compare.hpp"
@@ -7,9 +7,9 @@
 #include "integrators/integrator.hpp"
 #include "integrators/integrator_settings.hpp"
 #include "integrators/runs/run_driver.hpp"
-#include "lib/openmp_wait_policy.hpp"  // passive OpenMP waiting in every app (linked into each of them)
+#include "lib/linalg/openmp_wait_policy.hpp"  // passive OpenMP waiting in every app (linked into each of them)
 #include "integrators/checkpoint/checkpoint.hpp"  // load_saved_state: read_checkpoint (with or without MPI)
-#include "lib/state_output.hpp"                   // load_saved_state: state_from_vtu
+#include "lib/io/state_output.hpp"                   // load_saved_state: state_from_vtu
 #ifdef SHELLDYN_HAVE_MPI
 #include "integrators/runs/mpi_executor.hpp"
 #endif
@@ -195,7 +195,7 @@ void check_output_folder(const std::string& dir) {
 
 void prepare_result_folder(const std::string& dir, bool overwrite) {
   check_output_folder(dir);
-  // The folder is this command's until it exits (lib/result_folder.hpp, docs/guide/result-folders.md): taken
+  // The folder is this command's until it exits (lib/io/result_folder.hpp, docs/guide/result-folders.md): taken
   // before anything is looked at or removed, so that a second command cannot write or delete under it.
   hold_result_folder(dir, overwrite ? StaleLock::take_over : StaleLock::refuse, &std::cerr);
   static const std::vector<std::string> outputs = {
@@ -355,7 +355,7 @@ int BenchmarkApp::main(int argc, char** argv) {
     print_error(std::cerr, name_ + ": ", e.what());
     return e.exit_code();
   } catch (const std::exception& e) {
-    record_failure(e.what());  // a held result folder still "incomplete: running" gets the reason (lib/result_folder.hpp)
+    record_failure(e.what());  // a held result folder still "incomplete: running" gets the reason (lib/io/result_folder.hpp)
     print_error(std::cerr, name_ + ": error: ", e.what());
     return 1;
   }

@@ -10,8 +10,8 @@
 #pragma once
 
 #include "integrators/runs/executor.hpp"
-#include "lib/case_file.hpp"
-#include "lib/problem.hpp"
+#include "lib/io/case_file.hpp"
+#include "lib/model/problem.hpp"
 
 #include <CLI/CLI.hpp>
 

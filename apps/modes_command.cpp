@@ -3,12 +3,12 @@
 #include "apps/app_common.hpp"
 #include "integrators/runs/static_run.hpp"
 #include "integrators/sundials/sundials_info.hpp"
-#include "lib/linear_solver.hpp"
-#include "lib/modal_analysis.hpp"
-#include "lib/problem.hpp"
-#include "lib/run_info.hpp"
-#include "lib/state_output.hpp"
-#include "lib/vtu_writer.hpp"
+#include "lib/linalg/linear_solver.hpp"
+#include "lib/analysis/modal_analysis.hpp"
+#include "lib/model/problem.hpp"
+#include "lib/io/run_info.hpp"
+#include "lib/io/state_output.hpp"
+#include "lib/io/vtu_writer.hpp"
 
 #include <cstdlib>
 #include <cmath>

@@ -7,7 +7,7 @@
 // which needs rho ≈ 1e-3. --density chooses (default 1000, as printed); results go to
 // results/pinched-hemisphere-rho<density>/<integrator>/. The app reports, for the density used,
 //   (1) the linearised eigen-periods at t = 0: K φ = ω² M φ on the free DOFs by the shift-invert Lanczos
-//       of lib/modal_analysis.hpp (the six rigid-body modes of the free shell are skipped; the same numbers as
+//       of lib/analysis/modal_analysis.hpp (the six rigid-body modes of the free shell are skipped; the same numbers as
 //       `shelldyn modes apps/cases/pinched-hemisphere.yaml`), and
 //   (2) the period measured in the run: upward crossings of the mean of the radial displacement u_r at
 //       A = (R,0,0) after the loads end (needs about 1.5 periods of history, i.e. t_end ≳ 0.1 s at
@@ -27,7 +27,7 @@
 #include "apps/app_common.hpp"
 #include "integrators/runs/compare.hpp"
 #include "integrators/runs/run_driver.hpp"
-#include "lib/modal_analysis.hpp"
+#include "lib/analysis/modal_analysis.hpp"
 
 #include <cmath>
 #include <iostream>
@@ -58,7 +58,7 @@ int main(int argc, char** argv) {
                        (density == 1000.0 ? " as printed" : " (not as printed; see §3.3)");
   };
   app.before_run = [&](const Problem& problem) {
-    ModalOptions mo;  // lib/modal_analysis.hpp: the free shell has six rigid-body modes, then the elastic ones
+    ModalOptions mo;  // lib/analysis/modal_analysis.hpp: the free shell has six rigid-body modes, then the elastic ones
     mo.num_modes = 10;
     const auto T = elastic_periods(modal_analysis(*problem.model, problem.initial_state(), mo), 4);
     std::cout << "pinched_hemisphere: linearised eigen-periods at t = 0 (rho = " << density << "):";

@@ -6,8 +6,8 @@
 //   shelldyn check apps/cases/flying-plate.yaml              # validate, summarise, write results/flying-plate/
 //   shelldyn check apps/cases/pinched-hemisphere.yaml -o /tmp/hemi
 //
-// `check` reads a case file (lib/case_file.hpp), builds its discretization (mesh, sets, constraints,
-// loads; lib/discretization.hpp), prints a summary and writes the initial state as
+// `check` reads a case file (lib/io/case_file.hpp), builds its discretization (mesh, sets, constraints,
+// loads; lib/model/discretization.hpp), prints a summary and writes the initial state as
 // DIR/fields/step_000000.vtu + DIR/fields.pvd and DIR/run.json with status "checked", so the set-up
 // can be inspected in ParaView before any time is spent integrating.
 //
@@ -29,12 +29,12 @@
 #include "integrators/runs/run_driver.hpp"
 #include "integrators/runs/static_run.hpp"
 #include "integrators/sundials/sundials_info.hpp"
-#include "lib/case_file.hpp"
-#include "lib/discretization.hpp"
-#include "lib/result_folder.hpp"
-#include "lib/run_info.hpp"
-#include "lib/state_output.hpp"
-#include "lib/vtu_writer.hpp"
+#include "lib/io/case_file.hpp"
+#include "lib/model/discretization.hpp"
+#include "lib/io/result_folder.hpp"
+#include "lib/io/run_info.hpp"
+#include "lib/io/state_output.hpp"
+#include "lib/io/vtu_writer.hpp"
 
 #include <CLI/CLI.hpp>
 
@@ -262,7 +262,7 @@ struct RunCommandOptions {
   long long max_steps = 0;
   bool quiet = false, overwrite = false, plots = false;
   bool allow_changed_case = false, allow_other_version = false;  // resume (integrators/checkpoint/checkpoint.hpp)
-  std::string max_memory;                                         // --max-memory (lib/result_folder.hpp)
+  std::string max_memory;                                         // --max-memory (lib/io/result_folder.hpp)
   CLI::App* cli = nullptr;  // to ask which flags were given
   bool given(const char* flag) const {
     const CLI::Option* opt = cli ? cli->get_option_no_throw(flag) : nullptr;
@@ -279,7 +279,7 @@ void check_run_flags(const RunCommandOptions& o) {
   if (o.given("--threads")) app::check_range("--threads", o.threads, 0, 1024, "--threads 2");
   if (o.given("--max-steps")) app::check_range("--max-steps", o.max_steps, 0, 10000000000LL, "--max-steps 100000");
   if (o.given("--max-wall")) app::check_non_negative("--max-wall", o.max_wall, "--max-wall 3600");
-  if (o.given("--max-memory")) set_memory_limit(parse_memory_size(o.max_memory));  // lib/result_folder.hpp
+  if (o.given("--max-memory")) set_memory_limit(parse_memory_size(o.max_memory));  // lib/io/result_folder.hpp
 }
 
 std::pair<std::string, std::string> split_setting(const std::string& kv) {
@@ -380,7 +380,7 @@ int run_resume_locked(const RunCommandOptions& o, const std::string& dir) {
   const Checkpoint c = read_checkpoint(ckpt);
   check_checkpoint_origin(c, ckpt, o.allow_changed_case, o.allow_other_version, &std::cerr);
   load_checkpoint_plugins(c);  // the run's plugins, unless given again with --plugin
-  // A run killed with SIGKILL leaves its disk reserve (lib/run_info.hpp DiskReserve) behind, and possibly the
+  // A run killed with SIGKILL leaves its disk reserve (lib/io/run_info.hpp DiskReserve) behind, and possibly the
   // temporary of an output it was rewriting (run.json, fields.pvd and checkpoint.cbor are written whole to
   // NAME.tmp, then renamed; the complete file from before is still in place). Both are stale: remove them (the
   // resumed run allocates its own reserve and deletes it at the end, whatever the outcome).
@@ -405,7 +405,7 @@ int run_resume_locked(const RunCommandOptions& o, const std::string& dir) {
   return 0;
 }
 
-// The folder is locked first (lib/result_folder.hpp): a resume never runs beside the run it continues. A
+// The folder is locked first (lib/io/result_folder.hpp): a resume never runs beside the run it continues. A
 // failure keeps the folder's earlier status in run.json and records why ("resume_failed").
 int run_resume(const RunCommandOptions& o) {
   check_run_flags(o);
@@ -766,7 +766,7 @@ int main(int argc, char** argv) {
     app::print_error(std::cerr, "shelldyn: ", e.what());
     return e.exit_code();
   } catch (const std::exception& e) {
-    record_failure(e.what());  // a held result folder still "incomplete: running" gets the reason (lib/result_folder.hpp)
+    record_failure(e.what());  // a held result folder still "incomplete: running" gets the reason (lib/io/result_folder.hpp)
     app::print_error(std::cerr, "shelldyn: error: ", e.what());
     return 1;
   } catch (...) {  // e.g. a plugin throwing something that is not a std::exception

@@ -17,8 +17,8 @@
 // changes the values, not the pattern or the fill), and benchmarks every back-end on it. All other
 // arguments go to Google Benchmark (--benchmark_filter=..., --benchmark_repetitions=..., see --help). The CPU
 // column of these benchmarks is the whole process's CPU time, so a back-end's helper threads would show.
-#include "lib/linear_solver.hpp"
-#include "lib/problem.hpp"
+#include "lib/linalg/linear_solver.hpp"
+#include "lib/model/problem.hpp"
 
 #include <benchmark/benchmark.h>
 

@@ -10,8 +10,8 @@
 // on a shared 2-core machine compare ratios within one run.
 #include "integrators/newmark/em_generalized_alpha.hpp"
 #include "integrators/runs/registry.hpp"
-#include "lib/linear_solver.hpp"
-#include "lib/problem.hpp"
+#include "lib/linalg/linear_solver.hpp"
+#include "lib/model/problem.hpp"
 
 #include <benchmark/benchmark.h>
 #include <omp.h>

@@ -26,9 +26,9 @@
 #include "integrators/integrator.hpp"
 #include "integrators/integrator_settings.hpp"
 #include "integrators/runs/registry.hpp"
-#include "lib/case_file.hpp"
-#include "lib/linear_solver.hpp"
-#include "lib/problem.hpp"
+#include "lib/io/case_file.hpp"
+#include "lib/linalg/linear_solver.hpp"
+#include "lib/model/problem.hpp"
 
 #include <cholmod.h>
 #include <omp.h>

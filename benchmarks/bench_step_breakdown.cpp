@@ -4,7 +4,7 @@
 //   build/bin/bench_step_breakdown apps/cases/flying-plate.yaml --from 2.0 --steps 1000 --set newton=full
 //
 // Integrates the case with its integrator (settings from the case, overridden by --set/--integrator/--dt),
-// first without measuring up to --from, then --steps steps with lib/profile.hpp switched on, and prints
+// first without measuring up to --from, then --steps steps with lib/analysis/profile.hpp switched on, and prints
 // one row per instrumented section: process CPU ms per call (all threads), calls per step, CPU ms per
 // step and share of the step's CPU time, then wall ms per step and share of the step's wall time. The row
 // "Newton overhead (rest)" is the step's time not covered by any section: KINSOL, vector copies, the
@@ -16,10 +16,10 @@
 // the scheme stops, for comparisons of iteration counts at equal accuracy (docs/theory/exact-energy-momentum.md §5.9).
 #include "integrators/integrator.hpp"
 #include "integrators/runs/registry.hpp"
-#include "lib/profile.hpp"
-#include "lib/problem.hpp"
+#include "lib/analysis/profile.hpp"
+#include "lib/model/problem.hpp"
 
-#include "lib/openmp_wait_policy.hpp"
+#include "lib/linalg/openmp_wait_policy.hpp"
 #include <omp.h>
 
 #include <algorithm>

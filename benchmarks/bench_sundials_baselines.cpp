@@ -14,7 +14,7 @@
 // |ΔH|/H₀ (H = K + V − W_ext), |Δ|J||/|J₀|, and for R2 the errors of K and |J| against the exact values.
 #include "integrators/baselines/arkode_integrators.hpp"
 #include "integrators/baselines/ida_bdf.hpp"
-#include "lib/problem.hpp"
+#include "lib/model/problem.hpp"
 #include "tests/integrators/baseline_cases.hpp"
 
 #include <omp.h>

@@ -1,6 +1,6 @@
 # Sequential MUMPS 5.5 (Debian 12: libmumps-seq-dev + libmumps-headers-dev) ships no CMake config: find the
 # double-precision C interface and its library by hand (docs/dependencies.md §2.4). The library is not linked:
-# lib/linear_solver.cpp loads it with dlopen(RTLD_LOCAL), because its built-in MPI stubs export MPI_Init & co.
+# lib/linalg/linear_solver.cpp loads it with dlopen(RTLD_LOCAL), because its built-in MPI stubs export MPI_Init & co.
 # and would shadow Open MPI in executables that use both. Its full path is compiled in.
 if(NOT TARGET MUMPS::dmumps_seq)
   find_path(MUMPS_INCLUDE_DIR dmumps_c.h PATH_SUFFIXES mumps_seq)

@@ -1,11 +1,11 @@
-// libFuzzer target: the case-file reader (lib/case_file.hpp) and the validation of the integrator
+// libFuzzer target: the case-file reader (lib/io/case_file.hpp) and the validation of the integrator
 // block that `shelldyn check` and `shelldyn run` share (integrators/runs/case_integrator.hpp).
 //
 // Contract under test: any byte string either yields a CaseSpec or throws std::runtime_error /
 // std::invalid_argument with a message. Anything else (another exception type, a crash, a sanitizer
 // report, a hang) is a finding. Run with scripts/fuzz.sh.
 #include "integrators/runs/case_integrator.hpp"
-#include "lib/case_file.hpp"
+#include "lib/io/case_file.hpp"
 
 #include <cstddef>
 #include <cstdint>

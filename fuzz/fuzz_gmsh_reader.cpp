@@ -1,10 +1,10 @@
-// libFuzzer target: the Gmsh MSH 4.1 reader (lib/gmsh_reader.hpp), then the orientation pass every
-// file mesh goes through (lib/nodal_normals.hpp).
+// libFuzzer target: the Gmsh MSH 4.1 reader (lib/mesh/gmsh_reader.hpp), then the orientation pass every
+// file mesh goes through (lib/mesh/nodal_normals.hpp).
 //
 // Contract under test: any byte string either yields a Mesh or throws std::runtime_error /
 // std::invalid_argument with a message; anything else is a finding. Run with scripts/fuzz.sh.
-#include "lib/gmsh_reader.hpp"
-#include "lib/nodal_normals.hpp"
+#include "lib/mesh/gmsh_reader.hpp"
+#include "lib/mesh/nodal_normals.hpp"
 
 #include <cstddef>
 #include <cstdint>

@@ -14,8 +14,8 @@
 #pragma once
 
 #include "integrators/integrator_settings.hpp"
-#include "lib/semi_discrete_system.hpp"
-#include "lib/state.hpp"
+#include "lib/model/semi_discrete_system.hpp"
+#include "lib/model/state.hpp"
 
 #include <Eigen/Core>
 

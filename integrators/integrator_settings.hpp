@@ -3,7 +3,7 @@
 // the integrator understands, so a typo never silently falls back to a default.
 #pragma once
 
-#include "lib/case_file.hpp"
+#include "lib/io/case_file.hpp"
 
 #include <set>
 #include <string>

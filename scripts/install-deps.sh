@@ -10,11 +10,11 @@ PACKAGES=(
   cmake g++ make                       # toolchain
   libsundials-dev                      # SUNDIALS 6.4.1: KINSOL, IDA, ARKODE (+ KLU linear solver)
   libsuitesparse-dev                   # KLU, CHOLMOD
-  libmumps-seq-dev                     # sequential MUMPS: the "mumps" linear solver (lib/linear_solver.cpp)
+  libmumps-seq-dev                     # sequential MUMPS: the "mumps" linear solver (lib/linalg/linear_solver.cpp)
   libopenblas0-pthread                 # fast BLAS for CHOLMOD's supernodal factorization
   libeigen3-dev                        # Eigen 3.4
   libyaml-cpp-dev libcli11-dev         # case files, command line
-  nlohmann-json3-dev                   # run.json and checkpoints (lib/run_info, integrators/checkpoint)
+  nlohmann-json3-dev                   # run.json and checkpoints (lib/io/run_info, integrators/checkpoint)
   libspectra-dev                       # Spectra: shift-invert Lanczos of `shelldyn modes` (header-only)
   libgtest-dev libgmock-dev            # unit tests
   libbenchmark-dev                     # performance programs

@@ -9,8 +9,8 @@
 // of the mesh: `substeps` steps per time step of the case.
 #include "integrators/integrator.hpp"
 #include "integrators/runs/plugin.hpp"
-#include "lib/assembler.hpp"
-#include "lib/linear_solver.hpp"
+#include "lib/model/assembler.hpp"
+#include "lib/linalg/linear_solver.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -1,7 +1,7 @@
 #include "integrators/baselines/first_order_system.hpp"
 
-#include "lib/assembler.hpp"
-#include "lib/model.hpp"
+#include "lib/model/assembler.hpp"
+#include "lib/model/model.hpp"
 
 #include <algorithm>
 #include <cmath>

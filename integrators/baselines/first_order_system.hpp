@@ -30,9 +30,9 @@
 // mass_factorizations() counts the factorizations, mass_refinements() the corrections.
 #pragma once
 
-#include "lib/linear_solver.hpp"
-#include "lib/semi_discrete_system.hpp"
-#include "lib/state.hpp"
+#include "lib/linalg/linear_solver.hpp"
+#include "lib/model/semi_discrete_system.hpp"
+#include "lib/model/state.hpp"
 
 #include <Eigen/Core>
 #include <memory>

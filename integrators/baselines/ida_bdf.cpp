@@ -4,7 +4,7 @@
 #include "integrators/baselines/sundials_baseline.hpp"
 #include "integrators/sundials/callback_linear_solver.hpp"
 #include "integrators/sundials/sundials_support.hpp"
-#include "lib/assembler.hpp"
+#include "lib/model/assembler.hpp"
 
 #include <ida/ida.h>
 #include <ida/ida_ls.h>

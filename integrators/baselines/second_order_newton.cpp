@@ -1,6 +1,6 @@
 #include "integrators/baselines/second_order_newton.hpp"
 
-#include "lib/assembler.hpp"
+#include "lib/model/assembler.hpp"
 
 #include <algorithm>
 #include <stdexcept>

@@ -22,9 +22,9 @@
 // before factorize(); the values are kept, so solve() uses the blocks of the last factorize().
 #pragma once
 
-#include "lib/dof_map.hpp"
-#include "lib/linear_solver.hpp"
-#include "lib/sparse_matrix.hpp"
+#include "lib/model/dof_map.hpp"
+#include "lib/linalg/linear_solver.hpp"
+#include "lib/linalg/sparse_matrix.hpp"
 
 #include <Eigen/Core>
 #include <memory>

@@ -1,7 +1,7 @@
 #include "integrators/checkpoint/checkpoint.hpp"
 
-#include "lib/result_folder.hpp"
-#include "lib/run_info.hpp"
+#include "lib/io/result_folder.hpp"
+#include "lib/io/run_info.hpp"
 
 #include <nlohmann/json.hpp>
 
@@ -170,7 +170,7 @@ Checkpoint read_checkpoint(const std::string& path) {
   if (!in) {
     std::error_code ec;
     if (std::filesystem::exists(path, ec)) throw std::runtime_error(path + ": cannot read the checkpoint (permission denied?)");
-    // Why there is none (the run completed, wrote none, ...): lib/result_folder.hpp.
+    // Why there is none (the run completed, wrote none, ...): lib/io/result_folder.hpp.
     throw std::runtime_error(explain_missing_checkpoint(std::filesystem::path(path).parent_path().string()));
   }
   const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());

@@ -1,7 +1,7 @@
 // Checkpoint files of dynamic runs (docs/architecture.md "Checkpoints and resume").
 //
 // A checkpoint holds everything needed to continue a run as if it had never stopped:
-//   state        t, u, v, a, pdot and the director chart of every node (lib/state.hpp)
+//   state        t, u, v, a, pdot and the director chart of every node (lib/model/state.hpp)
 //   integrator   the integrator's own data (Integrator::save: W_ext, history vectors, solver state)
 //   numbers      the run driver's counters and reference quantities (output index, history.csv
 //                size, summary extrema, ...), and the options needed to rebuild the run
@@ -21,7 +21,7 @@
 #pragma once
 
 #include "integrators/integrator.hpp"
-#include "lib/state.hpp"
+#include "lib/model/state.hpp"
 
 #include <Eigen/Core>
 

@@ -1,7 +1,7 @@
 #include "integrators/newmark/consistent_acceleration.hpp"
 
-#include "lib/assembler.hpp"
-#include "lib/linear_solver.hpp"
+#include "lib/model/assembler.hpp"
+#include "lib/linalg/linear_solver.hpp"
 
 namespace shelldyn {
 

@@ -3,8 +3,8 @@
 // from it; em-exact's `predictor = newmark` does the same (docs/theory/exact-energy-momentum.md §5.9).
 #pragma once
 
-#include "lib/semi_discrete_system.hpp"
-#include "lib/state.hpp"
+#include "lib/model/semi_discrete_system.hpp"
+#include "lib/model/state.hpp"
 
 #include <Eigen/Core>
 #include <string>
@@ -12,7 +12,7 @@
 namespace shelldyn {
 
 // Solves for a (size num_dofs) with a fresh factorization of M(u) by `linear_solver` (a registered name,
-// lib/linear_solver.hpp). F_m includes the system's damping force C v, if it has one.
+// lib/linalg/linear_solver.hpp). F_m includes the system's damping force C v, if it has one.
 void consistent_acceleration(const SemiDiscreteSystem& sys, const State& s, const std::string& linear_solver,
                              Eigen::VectorXd& a);
 

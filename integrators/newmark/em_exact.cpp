@@ -7,9 +7,9 @@
 #include "integrators/newmark/kept_iteration_matrix.hpp"
 #include "integrators/nonlinear/energy_floor_test.hpp"
 #include "integrators/nonlinear/newton_solver.hpp"
-#include "lib/assembler.hpp"
-#include "lib/linear_solver.hpp"
-#include "lib/exact_energy_system.hpp"
+#include "lib/model/assembler.hpp"
+#include "lib/linalg/linear_solver.hpp"
+#include "lib/model/exact_energy_system.hpp"
 
 #include <algorithm>
 #include <array>
@@ -242,7 +242,7 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
   void initialize(SemiDiscreteSystem& sys, State& s) override {
     model_ = dynamic_cast<ExactEnergySystem*>(&sys);
     if (!model_)
-      throw std::invalid_argument("em-exact: needs a system with the ExactEnergySystem extension (lib/exact_energy_system.hpp: embedded director velocities, element energies), such as the CR9 shell Model; got another system");
+      throw std::invalid_argument("em-exact: needs a system with the ExactEnergySystem extension (lib/model/exact_energy_system.hpp: embedded director velocities, element energies), such as the CR9 shell Model; got another system");
     // Its embedded formulation takes nodal dead loads only (docs/manual.md §2.7–2.8): refuse what it would ignore.
     if (model_->has_damping() || model_->has_follower_loads())
       throw std::invalid_argument("em-exact: Rayleigh damping and follower pressures are not supported by this "

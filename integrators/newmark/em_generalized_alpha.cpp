@@ -4,9 +4,9 @@
 #include "integrators/newmark/kept_iteration_matrix.hpp"
 #include "integrators/nonlinear/energy_floor_test.hpp"
 #include "integrators/nonlinear/newton_solver.hpp"
-#include "lib/assembler.hpp"
-#include "lib/linear_solver.hpp"
-#include "lib/profile.hpp"
+#include "lib/model/assembler.hpp"
+#include "lib/linalg/linear_solver.hpp"
+#include "lib/analysis/profile.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -98,7 +98,7 @@ class NewmarkFamily final : public Integrator {
     if (floor_test != "correction" && floor_test != "estimate")
       throw std::invalid_argument(name_ + ".floor_test: '" + floor_test + "' (use correction or estimate)");
     floor_estimate_ = (floor_test == "estimate");
-    // CHOLMOD's supernodal Cholesky by default (simplicial LDLᵀ if K̄ is ever indefinite, lib/linear_solver.hpp):
+    // CHOLMOD's supernodal Cholesky by default (simplicial LDLᵀ if K̄ is ever indefinite, lib/linalg/linear_solver.hpp):
     // with its hidden threads switched off it factorizes the hemisphere's K̄ in ~0.8x and solves in ~0.6x the
     // CPU time of Eigen's simplicial LDLᵀ, and with a kept factorization the solves dominate
     // (benchmarks/bench_step_breakdown.cpp).

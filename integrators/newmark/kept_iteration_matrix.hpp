@@ -8,8 +8,8 @@
 #include "elements/director.hpp"
 #include "integrators/integrator.hpp"
 #include "integrators/nonlinear/newton_solver.hpp"
-#include "lib/semi_discrete_system.hpp"
-#include "lib/sparse_matrix.hpp"
+#include "lib/model/semi_discrete_system.hpp"
+#include "lib/linalg/sparse_matrix.hpp"
 
 #include <cmath>
 #include <stdexcept>

@@ -51,8 +51,8 @@
 // std::invalid_argument from the constructor.
 #pragma once
 
-#include "lib/linear_solver.hpp"
-#include "lib/sparse_matrix.hpp"
+#include "lib/linalg/linear_solver.hpp"
+#include "lib/linalg/sparse_matrix.hpp"
 
 #include <functional>
 #include <memory>

@@ -2,7 +2,7 @@
 // arc-length constraint of Crisfield's cylindrical method with the usual root choice.
 #pragma once
 
-#include "lib/dof_map.hpp"
+#include "lib/model/dof_map.hpp"
 
 #include <Eigen/Core>
 #include <string>

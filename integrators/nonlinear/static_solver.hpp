@@ -46,8 +46,8 @@
 #pragma once
 
 #include "integrators/nonlinear/path_following.hpp"
-#include "lib/model.hpp"
-#include "lib/state.hpp"
+#include "lib/model/model.hpp"
+#include "lib/model/state.hpp"
 
 #include <functional>
 #include <limits>

@@ -10,7 +10,7 @@
 #pragma once
 
 #include "integrators/integrator.hpp"
-#include "lib/case_file.hpp"
+#include "lib/io/case_file.hpp"
 
 #include <memory>
 #include <string>

@@ -7,10 +7,10 @@
 
 #include "integrators/integrator.hpp"
 #include "integrators/integrator_settings.hpp"
-#include "lib/case_file.hpp"
-#include "lib/history_writer.hpp"
-#include "lib/problem.hpp"
-#include "lib/run_info.hpp"
+#include "lib/io/case_file.hpp"
+#include "lib/io/history_writer.hpp"
+#include "lib/model/problem.hpp"
+#include "lib/io/run_info.hpp"
 
 #include <algorithm>
 #include <atomic>

@@ -4,11 +4,11 @@
 
 #include "integrators/runs/plugin.hpp"
 #include "integrators/sundials/sundials_info.hpp"
-#include "lib/history_writer.hpp"
-#include "lib/reactions.hpp"
-#include "lib/result_folder.hpp"
-#include "lib/run_info.hpp"
-#include "lib/state_output.hpp"
+#include "lib/io/history_writer.hpp"
+#include "lib/model/reactions.hpp"
+#include "lib/io/result_folder.hpp"
+#include "lib/io/run_info.hpp"
+#include "lib/io/state_output.hpp"
 
 #include <omp.h>
 #include <unistd.h>
@@ -352,8 +352,8 @@ RunSummary run_dynamic(Problem& problem, const RunOptions& o) {
   const bool files = !o.out_dir.empty();
   const std::string run_json_path = o.out_dir + "/run.json";
   const std::string checkpoint_path = o.out_dir + "/" + checkpoint_file_name();
-  std::unique_ptr<DiskReserve> reserve;  // room for the final run.json on a disk the outputs fill (lib/run_info.hpp)
-  // One writer per result folder (lib/result_folder.hpp); re-entrant: the CLI commands already hold theirs.
+  std::unique_ptr<DiskReserve> reserve;  // room for the final run.json on a disk the outputs fill (lib/io/run_info.hpp)
+  // One writer per result folder (lib/io/result_folder.hpp); re-entrant: the CLI commands already hold theirs.
   const FolderLock folder_lock = files ? FolderLock(o.out_dir, StaleLock::take_over, &std::cerr) : FolderLock();
   if (files) {
     prepare_output_folder(o.out_dir);

@@ -38,7 +38,7 @@
 
 #include "integrators/checkpoint/checkpoint.hpp"
 #include "integrators/integrator.hpp"
-#include "lib/problem.hpp"
+#include "lib/model/problem.hpp"
 
 #include <functional>
 #include <stdexcept>

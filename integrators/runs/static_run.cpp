@@ -4,9 +4,9 @@
 
 #include "integrators/integrator_settings.hpp"
 #include "integrators/sundials/sundials_info.hpp"
-#include "lib/reactions.hpp"
-#include "lib/run_info.hpp"
-#include "lib/state_output.hpp"
+#include "lib/model/reactions.hpp"
+#include "lib/io/run_info.hpp"
+#include "lib/io/state_output.hpp"
 
 #include <cerrno>
 #include <cstdio>
@@ -20,7 +20,7 @@ namespace shelldyn {
 namespace {
 
 // static.csv through a checked writer: every row is flushed, and a failed write (a full disk) is an error
-// naming the file, as for history.csv (lib/history_writer.hpp), instead of a silently truncated table.
+// naming the file, as for history.csv (lib/io/history_writer.hpp), instead of a silently truncated table.
 class CsvFile {
  public:
   explicit CsvFile(std::string path) : path_(std::move(path)), f_(std::fopen(path_.c_str(), "w")) {
@@ -114,7 +114,7 @@ std::vector<StaticRow> run_static(Problem& problem, const std::string& out_dir, 
 
   std::unique_ptr<CsvFile> csv;
   std::unique_ptr<PvdWriter> pvd;
-  std::unique_ptr<DiskReserve> reserve;  // room for the final run.json on a disk the outputs fill (lib/run_info.hpp)
+  std::unique_ptr<DiskReserve> reserve;  // room for the final run.json on a disk the outputs fill (lib/io/run_info.hpp)
   RunInfo info;
   info.sundials_version = sundials_version();
   info.status = "incomplete: running";

@@ -5,7 +5,7 @@
 #pragma once
 
 #include "integrators/nonlinear/static_solver.hpp"
-#include "lib/problem.hpp"
+#include "lib/model/problem.hpp"
 
 #include <ostream>
 #include <string>

@@ -3,7 +3,7 @@
 #include "integrators/runs/case_integrator.hpp"
 #include "integrators/runs/registry.hpp"
 
-#include "lib/problem.hpp"
+#include "lib/model/problem.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -1,13 +1,13 @@
 // Study files (docs/reference/study-files.md): the methods, sweeps, window, reference and full-duration runs of
 // `shelldyn study` as YAML, read into a StudyPreset (study.hpp). Messages share the case files' form
-// "FILE:LINE: key.path: reason (how to fix)" (lib/case_file.cpp). Methods are looked up only by name through
+// "FILE:LINE: key.path: reason (how to fix)" (lib/io/case_file.cpp). Methods are looked up only by name through
 // the registry (make_integrator, settings_understood_by), so a registered plug-in integrator is a method like
 // any built-in.
 #include "integrators/runs/number_text.hpp"
 #include "integrators/runs/registry.hpp"
 #include "integrators/runs/study.hpp"
 
-#include "lib/yaml_checks.hpp"
+#include "lib/io/yaml_checks.hpp"
 
 #include <yaml-cpp/yaml.h>
 

@@ -23,7 +23,7 @@
 #pragma once
 
 #include "integrators/sundials/sundials_support.hpp"
-#include "lib/linear_solver.hpp"
+#include "lib/linalg/linear_solver.hpp"
 
 #include <functional>
 #include <memory>

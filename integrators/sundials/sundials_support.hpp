@@ -7,7 +7,7 @@
 // everything and store the message in a CallbackError (see below).
 #pragma once
 
-#include "lib/sparse_matrix.hpp"
+#include "lib/linalg/sparse_matrix.hpp"
 
 #include <nvector/nvector_serial.h>
 #include <sundials/sundials_context.h>

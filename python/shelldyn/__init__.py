@@ -16,7 +16,7 @@ import os
 import shutil
 import tempfile
 
-# Passive OpenMP waiting, as the shelldyn executables set it (lib/openmp_wait_policy.hpp): libgomp reads the
+# Passive OpenMP waiting, as the shelldyn executables set it (lib/linalg/openmp_wait_policy.hpp): libgomp reads the
 # variable when it is loaded with the extension below; a value set by the user is kept.
 os.environ.setdefault("OMP_WAIT_POLICY", "passive")
 

@@ -3,9 +3,9 @@
 
 #include <pybind11/pybind11.h>
 
-#include "lib/model.hpp"
-#include "lib/semi_discrete_system.hpp"
-#include "lib/state.hpp"
+#include "lib/model/model.hpp"
+#include "lib/model/semi_discrete_system.hpp"
+#include "lib/model/state.hpp"
 
 #include <memory>
 #include <string>

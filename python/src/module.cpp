@@ -6,7 +6,7 @@
 //   - returned forces are NumPy arrays the C++ evaluation writes into directly;
 //   - matrices are scipy.sparse.csr_matrix whose values array owns the assembled std::vector (moved, not
 //     copied) and whose indices/indptr are int32 copies of the fixed pattern made once per system. The
-//     C++ storage is CSC with both triangles of a symmetric matrix (lib/sparse_matrix.hpp), and the CSC
+//     C++ storage is CSC with both triangles of a symmetric matrix (lib/linalg/sparse_matrix.hpp), and the CSC
 //     arrays of A are the CSR arrays of Aᵀ = A, so no transposition is needed.
 //   - an input vector u is copied once into an Eigen::VectorXd (the interface takes const VectorXd&), O(n).
 // The GIL is released during every C++ evaluation and run; C++ code calling back into Python (Python
@@ -25,9 +25,9 @@
 #include "integrators/runs/registry.hpp"
 #include "integrators/runs/run_driver.hpp"
 #include "integrators/runs/study.hpp"
-#include "lib/assembler.hpp"
-#include "lib/discretization.hpp"
-#include "lib/run_info.hpp"
+#include "lib/model/assembler.hpp"
+#include "lib/model/discretization.hpp"
+#include "lib/io/run_info.hpp"
 
 #include <chrono>
 #include <cmath>
@@ -350,7 +350,7 @@ py::dict study_row_dict(const StudyRow& r) {
   return d;
 }
 
-// Case-file problems are std::runtime_error in C++ (lib/case_file.hpp); from Python they are bad input.
+// Case-file problems are std::runtime_error in C++ (lib/io/case_file.hpp); from Python they are bad input.
 template <class F>
 auto input_errors(F&& f) -> decltype(f()) {
   try {
@@ -427,7 +427,7 @@ void bind_all(py::module_& m) {
       }, "(nodes, 4) array of n, m, l, s");
 
   py::class_<State>(m, "State",
-                    "The state at one instant (lib/state.hpp): u, v, a hold 5 entries per node [dX, dY, dZ, q1, q2]; "
+                    "The state at one instant (lib/model/state.hpp): u, v, a hold 5 entries per node [dX, dY, dZ, q1, q2]; "
                     "the arrays are views of the C++ vectors (assigning to a slice writes through).")
       .def(py::init<>())
       .def_readwrite("t", &State::t)
@@ -449,7 +449,7 @@ void bind_all(py::module_& m) {
 
   // --- the system -----------------------------------------------------------------------------------
   py::class_<PySystem>(m, "System",
-                       "The semi-discrete system M(q) q'' + F_m(q, q') + F_int(q) = F_ext(t, q) (lib/semi_discrete_system.hpp). "
+                       "The semi-discrete system M(q) q'' + F_m(q, q') + F_int(q) = F_ext(t, q) (lib/model/semi_discrete_system.hpp). "
                        "Matrices are unconstrained scipy.sparse.csr_matrix on one fixed pattern.")
       .def_property_readonly("num_dofs", [](const PySystem& s) { return s.get().num_dofs(); })
       .def_property_readonly("num_nodes", [](const PySystem& s) { return s.get().dofs().num_nodes(); })
@@ -673,7 +673,7 @@ void bind_all(py::module_& m) {
           py::arg("state"), "(nodes, 3) unit directors p(q) of a state");
 
   // --- cases ----------------------------------------------------------------------------------------
-  py::class_<PyCase>(m, "Case", "A case file (lib/case_file.hpp), loaded and validated; its settings can be overridden.")
+  py::class_<PyCase>(m, "Case", "A case file (lib/io/case_file.hpp), loaded and validated; its settings can be overridden.")
       .def_readonly("path", &PyCase::path)
       .def_property_readonly("name", [](const PyCase& c) { return c.spec.name; })
       .def_property_readonly("description", [](const PyCase& c) { return c.spec.description; })

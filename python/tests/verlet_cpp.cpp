@@ -16,8 +16,8 @@
 
 #include "integrators/integrator.hpp"
 #include "integrators/runs/registry.hpp"
-#include "lib/assembler.hpp"
-#include "lib/linear_solver.hpp"
+#include "lib/model/assembler.hpp"
+#include "lib/linalg/linear_solver.hpp"
 
 #include <chrono>
 #include <sstream>

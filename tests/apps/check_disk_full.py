@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""A run whose outputs fill the disk (docs/architecture.md "Checkpoints and resume", lib/run_info.hpp DiskReserve).
+"""A run whose outputs fill the disk (docs/architecture.md "Checkpoints and resume", lib/io/run_info.hpp DiskReserve).
 
 usage: check_disk_full.py SHELLDYN CASE WORK_DIR
 

@@ -1,6 +1,6 @@
-#include "lib/mesh_generators.hpp"
-#include "lib/nodal_normals.hpp"
-#include "lib/model.hpp"
+#include "lib/mesh/mesh_generators.hpp"
+#include "lib/mesh/nodal_normals.hpp"
+#include "lib/model/model.hpp"
 #include <cstdio>
 int main() {
   auto mesh = shelldyn::make_rectangle(1, 1, 2, 2);

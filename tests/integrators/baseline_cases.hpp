@@ -6,9 +6,9 @@
 
 #include "integrators/integrator.hpp"
 #include "tests/integrators/dynamics_fixtures.hpp"
-#include "lib/mesh_generators.hpp"
-#include "lib/model.hpp"
-#include "lib/nodal_normals.hpp"
+#include "lib/mesh/mesh_generators.hpp"
+#include "lib/model/model.hpp"
+#include "lib/mesh/nodal_normals.hpp"
 
 #include <memory>
 #include <string>

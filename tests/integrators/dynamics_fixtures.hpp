@@ -4,9 +4,9 @@
 #pragma once
 
 #include "integrators/newmark/em_generalized_alpha.hpp"
-#include "lib/mesh_generators.hpp"
-#include "lib/model.hpp"
-#include "lib/nodal_normals.hpp"
+#include "lib/mesh/mesh_generators.hpp"
+#include "lib/model/model.hpp"
+#include "lib/mesh/nodal_normals.hpp"
 
 #include <cmath>
 #include <memory>

@@ -8,7 +8,7 @@
 #include "dynamics_fixtures.hpp"
 
 #include "integrators/checkpoint/checkpoint.hpp"
-#include "lib/run_info.hpp"
+#include "lib/io/run_info.hpp"
 #include "integrators/runs/registry.hpp"
 
 #include <gtest/gtest.h>

@@ -5,7 +5,7 @@
 #include "integrators/newmark/em_exact.hpp"
 #include "integrators/runs/case_integrator.hpp"
 #include "integrators/runs/registry.hpp"
-#include "lib/problem.hpp"
+#include "lib/model/problem.hpp"
 
 #include "dynamics_fixtures.hpp"
 

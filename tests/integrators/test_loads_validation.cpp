@@ -10,9 +10,9 @@
 #include "integrators/nonlinear/static_solver.hpp"
 #include "integrators/runs/registry.hpp"
 #include "integrators/runs/static_run.hpp"
-#include "lib/linear_solver.hpp"
-#include "lib/problem.hpp"
-#include "lib/reactions.hpp"
+#include "lib/linalg/linear_solver.hpp"
+#include "lib/model/problem.hpp"
+#include "lib/model/reactions.hpp"
 
 #include <gtest/gtest.h>
 

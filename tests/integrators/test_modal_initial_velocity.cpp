@@ -4,8 +4,8 @@
 // must vibrate in mode k alone, at its frequency ω_k (small amplitude: linear range).
 #include "integrators/integrator_settings.hpp"
 #include "integrators/runs/registry.hpp"
-#include "lib/modal_analysis.hpp"
-#include "lib/problem.hpp"
+#include "lib/analysis/modal_analysis.hpp"
+#include "lib/model/problem.hpp"
 
 #include <gtest/gtest.h>
 

@@ -1,7 +1,7 @@
 // Stopping rules of modified Newton (docs/theory.md §6.5) and NewtonOptions::skip_final_residual.
 #include "integrators/nonlinear/newton_solver.hpp"
 #include "integrators/runs/registry.hpp"
-#include "lib/problem.hpp"
+#include "lib/model/problem.hpp"
 
 #include "dynamics_fixtures.hpp"
 

@@ -9,8 +9,8 @@
 #include "integrators/integrator_settings.hpp"
 #include "integrators/runs/case_integrator.hpp"
 #include "integrators/runs/registry.hpp"
-#include "lib/problem.hpp"
-#include "lib/reactions.hpp"
+#include "lib/model/problem.hpp"
+#include "lib/model/reactions.hpp"
 #include "tests/support/test_files.hpp"
 
 #include <gtest/gtest.h>

@@ -5,7 +5,7 @@
 // link to it.
 #include "integrators/runs/run_driver.hpp"
 #include "integrators/runs/static_run.hpp"
-#include "lib/problem.hpp"
+#include "lib/model/problem.hpp"
 #include "tests/support/test_files.hpp"
 
 #include <gtest/gtest.h>

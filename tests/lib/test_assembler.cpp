@@ -1,5 +1,5 @@
 // Sparse assembly against a dense reference (issue: foundation, item 6).
-#include "lib/assembler.hpp"
+#include "lib/model/assembler.hpp"
 
 #include <gtest/gtest.h>
 

@@ -1,6 +1,6 @@
-// Case-file parsing and validation (lib/case_file.hpp; architecture.md §5: unknown keys and wrong
+// Case-file parsing and validation (lib/io/case_file.hpp; architecture.md §5: unknown keys and wrong
 // types are errors that name the key and the line).
-#include "lib/case_file.hpp"
+#include "lib/io/case_file.hpp"
 
 #include <gtest/gtest.h>
 

@@ -1,6 +1,6 @@
-// From case to discrete problem (lib/discretization.hpp): meshes of the benchmark cases, set
+// From case to discrete problem (lib/model/discretization.hpp): meshes of the benchmark cases, set
 // resolution, load distribution, initial velocity, constraints, monitors and their errors.
-#include "lib/discretization.hpp"
+#include "lib/model/discretization.hpp"
 
 #include <gtest/gtest.h>
 

@@ -1,6 +1,6 @@
 // DOF numbering with constraints, including director constraints that follow chart switches
 // (docs/theory.md §2.3 item 2).
-#include "lib/dof_map.hpp"
+#include "lib/model/dof_map.hpp"
 
 #include <gtest/gtest.h>
 

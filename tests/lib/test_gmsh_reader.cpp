@@ -1,7 +1,7 @@
-// Gmsh MSH 4.1 ASCII reader (lib/gmsh_reader.hpp): a valid two-element file with physical groups and
+// Gmsh MSH 4.1 ASCII reader (lib/mesh/gmsh_reader.hpp): a valid two-element file with physical groups and
 // sparse node tags, and malformed files that must be rejected with FILE:LINE: reason.
-#include "lib/gmsh_reader.hpp"
-#include "lib/nodal_normals.hpp"
+#include "lib/mesh/gmsh_reader.hpp"
+#include "lib/mesh/nodal_normals.hpp"
 
 #include <gtest/gtest.h>
 

@@ -1,5 +1,5 @@
 // Initial velocity fields on sets and from CSV files (docs/manual.md §2.6).
-#include "lib/discretization.hpp"
+#include "lib/model/discretization.hpp"
 
 #include <gtest/gtest.h>
 

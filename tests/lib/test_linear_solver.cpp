@@ -1,8 +1,8 @@
-// Sparse direct solver back-ends (lib/linear_solver.hpp) on a 9-node-shell-like pattern:
+// Sparse direct solver back-ends (lib/linalg/linear_solver.hpp) on a 9-node-shell-like pattern:
 // ne x ne quadratic quads, (2ne+1)^2 nodes, 5 DOF per node, every element couples its 45 DOFs
 // (docs/dependencies.md §5.1). Values: per element a random SPD block B Bᵀ/45 + 0.01 I, so the assembled
 // matrix is SPD; an indefinite variant shifts the diagonal.
-#include "lib/linear_solver.hpp"
+#include "lib/linalg/linear_solver.hpp"
 
 #include <gtest/gtest.h>
 
@@ -301,7 +301,7 @@ TEST(LinearSolver, CholmodSinglePrecisionSolvesRefineToDouble) {
   EXPECT_EQ(s->stats().single_solves, singles);
 }
 
-// solve_precision = double with a supernodal LLᵀ factor runs the solves of lib/single_precision_factor on an exact
+// solve_precision = double with a supernodal LLᵀ factor runs the solves of lib/linalg/single_precision_factor on an exact
 // copy of CHOLMOD's factor (columns paired in the forward sweep). They must solve to double round-off, agree with
 // another back-end's solve, and give the same bits in place.
 TEST(LinearSolver, CholmodDoubleSolvesOnTheCopiedFactorAreExactToRoundOff) {
@@ -382,7 +382,7 @@ TEST(LinearSolver, SinglePrecisionSolvesOnlyWithCholmodSupernodal) {
 }
 
 // No hidden threads: CHOLMOD's supernodal kernels open OpenMP regions with a fixed num_threads(4) and
-// OpenBLAS (used by CHOLMOD and MUMPS) starts its own pool (lib/linear_solver.cpp). With one OpenMP thread requested, factorizing and
+// OpenBLAS (used by CHOLMOD and MUMPS) starts its own pool (lib/linalg/linear_solver.cpp). With one OpenMP thread requested, factorizing and
 // solving must not add a single thread to the process (counted in /proc/self/task). The matrix is large
 // enough (16 x 16 elements, 5445 unknowns) for supernodes wider than CHOLMOD's 32-column threshold.
 int process_threads() {

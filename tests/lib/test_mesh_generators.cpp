@@ -1,6 +1,6 @@
-// Built-in mesh generators (lib/mesh_generators.hpp): counts, exact geometry, sets, normals, area.
-#include "lib/mesh_generators.hpp"
-#include "lib/nodal_normals.hpp"
+// Built-in mesh generators (lib/mesh/mesh_generators.hpp): counts, exact geometry, sets, normals, area.
+#include "lib/mesh/mesh_generators.hpp"
+#include "lib/mesh/nodal_normals.hpp"
 
 #include <gtest/gtest.h>
 

@@ -1,9 +1,9 @@
-// Modal analysis (lib/modal_analysis.hpp) against closed forms: simply supported square plates
+// Modal analysis (lib/analysis/modal_analysis.hpp) against closed forms: simply supported square plates
 // (Kirchhoff for t/L = 0.005, Mindlin for t/L = 0.1, docs/modal.md), a free plate (six rigid-body
 // modes) and the free hemisphere of the dynamic benchmark (its linearised periods).
-#include "lib/modal_analysis.hpp"
-#include "lib/linear_solver.hpp"
-#include "lib/problem.hpp"
+#include "lib/analysis/modal_analysis.hpp"
+#include "lib/linalg/linear_solver.hpp"
+#include "lib/model/problem.hpp"
 
 #include <gtest/gtest.h>
 

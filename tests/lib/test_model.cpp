@@ -1,10 +1,10 @@
-// The assembled semi-discretization (lib/model): assembly glue, invariants, re-charting, thread
+// The assembled semi-discretization (lib/model/model): assembly glue, invariants, re-charting, thread
 // independence, and the linear pinched-hemisphere locking benchmark (docs/theory.md §7 item 9).
-#include "lib/model.hpp"
+#include "lib/model/model.hpp"
 
-#include "lib/linear_solver.hpp"
-#include "lib/mesh_generators.hpp"
-#include "lib/nodal_normals.hpp"
+#include "lib/linalg/linear_solver.hpp"
+#include "lib/mesh/mesh_generators.hpp"
+#include "lib/mesh/nodal_normals.hpp"
 
 #include <gtest/gtest.h>
 #include <omp.h>

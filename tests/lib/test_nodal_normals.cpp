@@ -1,6 +1,6 @@
 // Initial nodal normals, consistent orientation and the orientation check (docs/theory.md §2.4).
-#include "lib/mesh_generators.hpp"
-#include "lib/nodal_normals.hpp"
+#include "lib/mesh/mesh_generators.hpp"
+#include "lib/mesh/nodal_normals.hpp"
 
 #include <gtest/gtest.h>
 
@@ -14,7 +14,7 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
-// The reversal documented in lib/nodal_normals.hpp: corners (1,2,3,4) -> (1,4,3,2).
+// The reversal documented in lib/mesh/nodal_normals.hpp: corners (1,2,3,4) -> (1,4,3,2).
 Quad9 reverse(const Quad9& q) {
   return {q[0], q[3], q[2], q[1], q[7], q[6], q[5], q[4], q[8]};
 }

@@ -1,7 +1,7 @@
 // Output writers: history.csv, VTU/PVD, run.json (architecture.md §5).
-#include "lib/history_writer.hpp"
-#include "lib/run_info.hpp"
-#include "lib/vtu_writer.hpp"
+#include "lib/io/history_writer.hpp"
+#include "lib/io/run_info.hpp"
+#include "lib/io/vtu_writer.hpp"
 #include "tests/support/test_files.hpp"
 
 #include <gtest/gtest.h>

@@ -1,6 +1,6 @@
-// Result folders as transactions (lib/result_folder.hpp, docs/guide/result-folders.md).
-#include "lib/history_writer.hpp"
-#include "lib/result_folder.hpp"
+// Result folders as transactions (lib/io/result_folder.hpp, docs/guide/result-folders.md).
+#include "lib/io/history_writer.hpp"
+#include "lib/io/result_folder.hpp"
 
 #include <gtest/gtest.h>
 

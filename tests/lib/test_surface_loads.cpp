@@ -1,11 +1,11 @@
-// Distributed loads (lib/surface_loads, docs/theory.md §8.2–8.4): resultants of the consistent nodal
+// Distributed loads (lib/model/surface_loads, docs/theory.md §8.2–8.4): resultants of the consistent nodal
 // forces, the follower-pressure tangent against finite differences, and the case-file path.
-#include "lib/surface_loads.hpp"
+#include "lib/model/surface_loads.hpp"
 
 #include "elements/shape_functions.hpp"
-#include "lib/assembler.hpp"
-#include "lib/mesh_generators.hpp"
-#include "lib/problem.hpp"
+#include "lib/model/assembler.hpp"
+#include "lib/mesh/mesh_generators.hpp"
+#include "lib/model/problem.hpp"
 
 #include <gtest/gtest.h>
 

@@ -1,5 +1,5 @@
-// Time functions of the case file's loads (lib/time_function.hpp; docs/benchmarks.md §1.2, §3.1).
-#include "lib/time_function.hpp"
+// Time functions of the case file's loads (lib/model/time_function.hpp; docs/benchmarks.md §1.2, §3.1).
+#include "lib/model/time_function.hpp"
 
 #include <gtest/gtest.h>
 

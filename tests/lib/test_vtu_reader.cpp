@@ -1,10 +1,10 @@
-// Reading back shelldyn's VTU files (lib/vtu_reader.hpp): the velocity field of initial_velocity: {field:
+// Reading back shelldyn's VTU files (lib/io/vtu_reader.hpp): the velocity field of initial_velocity: {field:
 // FILE.vtu} (docs/manual.md §2.6) and the saved state of --state FILE.vtu (docs/manual.md §1), with the
 // errors a wrong file must give.
-#include "lib/problem.hpp"
-#include "lib/state_output.hpp"
-#include "lib/vtu_reader.hpp"
-#include "lib/vtu_writer.hpp"
+#include "lib/model/problem.hpp"
+#include "lib/io/state_output.hpp"
+#include "lib/io/vtu_reader.hpp"
+#include "lib/io/vtu_writer.hpp"
 #include "tests/support/test_files.hpp"
 
 #include <gtest/gtest.h>

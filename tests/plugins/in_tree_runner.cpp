@@ -4,7 +4,7 @@
 //   usage: example_in_tree_runner CASE.yaml T_END OUT_DIR
 #include "integrators/runs/registry.hpp"
 #include "integrators/runs/run_driver.hpp"
-#include "lib/problem.hpp"
+#include "lib/model/problem.hpp"
 
 #include <cstdlib>
 #include <iostream>
