@@ -533,6 +533,9 @@ int run_compare(const CompareCommandOptions& o) {
   co.resume = o.resume;
   const bool root = executor->collects();
   if (!root) co.log = nullptr;
+  // The sweep's folder is this command's until it exits (docs/guide/result-folders.md): a second compare into it
+  // is refused with one line naming the holder. A stale lock (a killed sweep) is taken over by --resume only.
+  if (root) hold_result_folder(co.out_dir, o.resume ? StaleLock::take_over : StaleLock::refuse, &std::cerr);
   if (root)
     std::cout << "shelldyn compare: " << stem << ", " << runs.size() << " runs on " << executor->describe() << " -> "
               << co.out_dir << std::endl;
@@ -663,6 +666,10 @@ int run_study_command(const StudyCommandOptions& o) {
   }
   // Where the runs execute: as `shelldyn compare` (the ranks of mpirun/srun, else --jobs threads).
   const std::unique_ptr<RunExecutor> executor = app::make_sweep_executor(o.jobs, 0);
+  // Each study folder is this command's until it exits, as for compare. A study continues the runs an earlier
+  // one left (its default), so a stale lock is taken over with a note.
+  if (!o.dry_run && executor->collects())
+    for (const auto& so : studies) hold_result_folder(so.out_dir, StaleLock::take_over, &std::cerr);
   for (auto& so : studies) {
     so.execution.jobs = o.jobs;
     so.execution.executor = executor.get();

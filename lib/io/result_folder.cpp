@@ -154,9 +154,14 @@ void acquire(const std::string& dir, StaleLock stale, std::ostream* note, bool s
       const std::string who = describe_holder(rec);
       if (stale == StaleLock::refuse) {
         ::close(fd);
-        throw FolderBusy(dir + ": left locked by " + who +
-                         ", which is no longer running (killed?); continue it with `shelldyn resume`, replace it with "
-                         "--overwrite, or remove " + lock_file_name() + " after checking the folder");
+        // The way to continue depends on what held it: a run (resume), a compare sweep (--resume), a study.
+        const std::string how = who.find(" compare ") != std::string::npos
+                                    ? "continue it with the same `shelldyn compare` and --resume"
+                                : who.find(" study ") != std::string::npos
+                                    ? "continue it with the same `shelldyn study` (it keeps the finished runs)"
+                                    : "continue it with `shelldyn resume`, replace it with --overwrite";
+        throw FolderBusy(dir + ": left locked by " + who + ", which is no longer running (killed?); " + how +
+                         ", or remove " + lock_file_name() + " after checking the folder");
       }
       if (note) *note << "note: " << dir << ": taking over the lock of " << who << ", which ended without releasing it" << std::endl;
     }
