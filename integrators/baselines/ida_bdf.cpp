@@ -9,9 +9,14 @@
 #include <ida/ida.h>
 #include <ida/ida_ls.h>
 
+#include <Eigen/SparseCore>
+#include <Eigen/SparseLU>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <sstream>
 
 namespace shelldyn {
@@ -54,12 +59,15 @@ class IdaBdf final : public SundialsBaseline {
   }
 
   ~IdaBdf() override { free_ida(); }
+  // Holonomic constraints as an index-2 stabilized (GGL) DAE (ida_bdf.hpp, docs/theory/multibody.md §7).
+  bool supports_constraints() const override { return true; }
 
  private:
   // --- SundialsBaseline hooks ---
   void create_solver(SemiDiscreteSystem& system, const State& state) override {
     free_ida();
-    const Index N = fos_->size();
+    m_ = system.num_constraints();
+    const Index N = fos_->size() + 2 * m_;  // GGL: λ, μ after [q; v; w; d]
     newton_ = std::make_unique<SecondOrderNewton>(system.pattern(), system.dofs(), linear_solver_);
     fext_.resize(n_);
     cv_.resize(n_);
@@ -68,6 +76,17 @@ class IdaBdf final : public SundialsBaseline {
     id_ = make_serial_vector(N, *ctx_);
     write_y(state);
     N_VConst(1.0, id_.get());
+    for (Index k = fos_->size(); k < N; ++k) data(id_.get())[k] = 0.0;  // λ, μ algebraic
+    if (m_ > 0) {  // tolerances of λ, μ (out of the error test, IDASetSuppressAlg; used by Newton's norm)
+      atol_all_ = make_serial_vector(N, *ctx_);
+      std::copy(data(atol_v_.get()), data(atol_v_.get()) + fos_->size(), data(atol_all_.get()));
+      // λ, μ: rtol · max(1, |λ₀|∞). Their Newton corrections scale like 1/h (index 2), so the energy-scaled atol of
+      // w (1e-11 at rtol 1e-8) made Newton's convergence test fail at the first steps.
+      Eigen::VectorXd a0, lambda0;
+      ggl_initial(state, a0, lambda0);
+      const double a_mult = rtol_ * std::max(1.0, lambda0.size() ? lambda0.cwiseAbs().maxCoeff() : 0.0);
+      for (Index k = fos_->size(); k < N; ++k) data(atol_all_.get())[k] = a_mult;
+    }
     J_ = make_placeholder_matrix(*ctx_);
     LS_ = make_callback_linear_solver(*ctx_, {[this] { return ls_setup(); },
                                               [this](const double* b, double* x) { return ls_solve(b, x); }});
@@ -76,11 +95,12 @@ class IdaBdf final : public SundialsBaseline {
     check_ptr(mem_, "IDACreate");
     check(IDASetErrHandlerFn(mem_, record_sundials_error, &sundials_message_), "IDASetErrHandlerFn");
     check(IDAInit(mem_, residual, t_, y_.get(), yp_.get()), "IDAInit");
-    check(IDASVtolerances(mem_, rtol_, atol_v_.get()), "IDASVtolerances");
+    check(IDASVtolerances(mem_, rtol_, m_ > 0 ? atol_all_.get() : atol_v_.get()), "IDASVtolerances");
     check(IDASetUserData(mem_, this), "IDASetUserData");
     check(IDASetLinearSolver(mem_, LS_.get(), J_.get()), "IDASetLinearSolver");
     check(IDASetJacFn(mem_, jacobian), "IDASetJacFn");
     check(IDASetId(mem_, id_.get()), "IDASetId");
+    if (m_ > 0) check(IDASetSuppressAlg(mem_, SUNTRUE), "IDASetSuppressAlg");
     check(IDASetMaxOrd(mem_, max_order_), "IDASetMaxOrd");
     check(IDASetDeltaCjLSetup(mem_, dcj_lsetup_), "IDASetDeltaCjLSetup");
     if (max_step_ > 0) check(IDASetMaxStep(mem_, max_step_), "IDASetMaxStep");
@@ -108,7 +128,9 @@ class IdaBdf final : public SundialsBaseline {
   void unpack(State& s) override { read_y(s); }
   bool acceleration_in_y() const override { return true; }
   void rebase_counters() override { base_ = IdaCounters{}; }
-  long factorizations() const override { return newton_ ? newton_->backend().stats().factorizations : 0; }
+  long factorizations() const override {
+    return (newton_ ? newton_->backend().stats().factorizations : 0) + ggl_factorizations_;
+  }
   double last_step() const override {
     double h = 0;
     IDAGetLastStep(mem_, &h);
@@ -123,6 +145,17 @@ class IdaBdf final : public SundialsBaseline {
     fos_->pack(s, w_, d_, y);
     std::copy(s.v.data(), s.v.data() + n_, yp);
     std::copy(s.a.data(), s.a.data() + n_, yp + n_);
+    if (m_ > 0) {  // consistent (v̇, λ) from the acceleration-level condition, μ = 0 (ggl_initial)
+      Eigen::VectorXd a, lambda;
+      ggl_initial(s, a, lambda);
+      std::copy(a.data(), a.data() + n_, yp + n_);
+      const Index k0 = fos_->size();
+      for (Index k = 0; k < m_; ++k) {
+        y[k0 + k] = lambda[k];
+        y[k0 + m_ + k] = 0.0;
+        yp[k0 + k] = yp[k0 + m_ + k] = 0.0;
+      }
+    }
     yp[fos_->work_index()] = wdot;
     yp[fos_->damping_index()] = fos_->damping_power(s.v);  // ḋ = vᵀ C v: consistent from the start
   }
@@ -219,6 +252,7 @@ class IdaBdf final : public SundialsBaseline {
       const FirstOrderSystem::Powers power = self->fos_->momentum_residual(t, s, self->a_, self->r_);
       for (Index i = 0; i < n; ++i) rv[i] = ypv[i] - yv[n + i];
       std::copy(self->r_.data(), self->r_.data() + n, rv + n);
+      if (self->m_ > 0) self->ggl_residual(t, s, yv, rv);
       rv[2 * n] = ypv[2 * n] - power.external;
       rv[2 * n + 1] = ypv[2 * n + 1] - power.damping;  // ḋ = vᵀ C v (first_order_system.hpp)
       return 0;
@@ -239,7 +273,7 @@ class IdaBdf final : public SundialsBaseline {
     auto* self = static_cast<IdaBdf*>(ud);
     try {
       self->cj_ = cj;
-      if (self->reuse_blocks()) return 0;  // only c_j changed enough for a new setup: refactorize, keep K, M, G
+      if (self->m_ == 0 && self->reuse_blocks()) return 0;  // only c_j changed enough: refactorize, keep K, M, G
       const Index n = self->n_;
       const double* yv = N_VGetArrayPointer(y);
       State& s = self->work_;
@@ -263,6 +297,7 @@ class IdaBdf final : public SundialsBaseline {
       else
         self->cv_.setZero();
       self->blocks_valid_ = true;
+      if (self->m_ > 0) self->ggl_jacobian(t, s, yv);
       return 0;
     } catch (const std::domain_error&) {
       return 1;
@@ -306,6 +341,7 @@ class IdaBdf final : public SundialsBaseline {
 
   int ls_setup() {
     try {
+      if (m_ > 0) return ggl_factorize();
       newton_->factorize(1.0 / cj_);
       return SUNLS_SUCCESS;
     } catch (...) {
@@ -319,6 +355,7 @@ class IdaBdf final : public SundialsBaseline {
   // c_j x_v,c = b_v,c); then x_w = (b_w + F_ext·x_v)/c_j and x_d = (b_d + 2 (C v)·x_v)/c_j.
   int ls_solve(const double* b, double* x) {
     try {
+      if (m_ > 0) return ggl_solve(b, x);
       const Index n = n_;
       const double g = newton_->gamma();
       rq_ = g * Eigen::Map<const Eigen::VectorXd>(b, n);
@@ -332,6 +369,177 @@ class IdaBdf final : public SundialsBaseline {
       errors_.capture("ida-bdf Newton solve");
       return SUNLS_PACKAGE_FAIL_UNREC;
     }
+  }
+
+  // ---- GGL (index-2 stabilized) form of the constrained system (ida_bdf.hpp) -------------------------------
+  using SpMat = Eigen::SparseMatrix<double, Eigen::ColMajor, Index>;
+  using Trip = Eigen::Triplet<double, Index>;
+
+  // The constraint rows of F: q rows += Gᵀμ, v rows += Gᵀλ, then g and G v + ∂g/∂t.
+  void ggl_residual(double t, const State& s, const double* yv, double* rv) {
+    const Index n = n_, k0 = fos_->size();
+    const Eigen::Map<const Eigen::VectorXd> lambda(yv + k0, m_), mu(yv + k0 + m_, m_);
+    sys_->constraint_jacobian(t, s.u, s.charts, Gc_);
+    const Eigen::VectorXd Gl = Gc_.transpose() * lambda, Gm = Gc_.transpose() * mu;
+    for (Index i = 0; i < n; ++i) {
+      rv[i] += Gm[i];
+      rv[n + i] += Gl[i];
+    }
+    Eigen::VectorXd g, gt;
+    sys_->constraint_values(t, s.u, s.charts, g);
+    sys_->constraint_time_derivative(t, s.u, s.charts, gt);
+    const Eigen::VectorXd gd = Gc_ * s.v + gt;
+    for (Index k = 0; k < m_; ++k) {
+      rv[k0 + k] = g[k];
+      rv[k0 + m_ + k] = gd[k];
+    }
+  }
+
+  // The constraint blocks of the Newton matrix at (t, y): G, the Hessian contractions ∂(Gᵀλ)/∂q, ∂(Gᵀμ)/∂q, and
+  // D = ∂(G v + ∂g/∂t)/∂q by central differences over the columns G touches.
+  void ggl_jacobian(double t, const State& s, const double* yv) {
+    const Index k0 = fos_->size();
+    const Eigen::Map<const Eigen::VectorXd> lambda(yv + k0, m_), mu(yv + k0 + m_, m_);
+    sys_->constraint_jacobian(t, s.u, s.charts, Gj_);
+    Hl_ = SparseMatrix{sys_->pattern(), std::vector<double>(static_cast<size_t>(sys_->pattern()->nnz()), 0.0)};
+    Hm_ = Hl_;
+    sys_->add_constraint_hessian(t, s.u, s.charts, lambda, 1.0, Hl_);
+    sys_->add_constraint_hessian(t, s.u, s.charts, mu, 1.0, Hm_);
+    std::vector<Index> cols;
+    for (Index r = 0; r < Gj_.outerSize(); ++r)
+      for (SemiDiscreteSystem::ConstraintMatrix::InnerIterator it(Gj_, r); it; ++it) cols.push_back(it.col());
+    std::sort(cols.begin(), cols.end());
+    cols.erase(std::unique(cols.begin(), cols.end()), cols.end());
+    D_.clear();
+    Eigen::VectorXd u = s.u, gt_p, gt_m;
+    SemiDiscreteSystem::ConstraintMatrix Gp, Gm;
+    for (Index j : cols) {
+      const double h = 1e-7 * std::max(1.0, std::abs(s.u[j]));
+      u[j] = s.u[j] + h;
+      sys_->constraint_jacobian(t, u, s.charts, Gp);
+      sys_->constraint_time_derivative(t, u, s.charts, gt_p);
+      u[j] = s.u[j] - h;
+      sys_->constraint_jacobian(t, u, s.charts, Gm);
+      sys_->constraint_time_derivative(t, u, s.charts, gt_m);
+      u[j] = s.u[j];
+      const Eigen::VectorXd col = (Eigen::VectorXd(Gp * s.v) + gt_p - Eigen::VectorXd(Gm * s.v) - gt_m) / (2.0 * h);
+      for (Index k = 0; k < m_; ++k)
+        if (col[k] != 0.0) D_.emplace_back(k, j, col[k]);
+    }
+  }
+
+  // Assembles and factorizes (sparse LU) the Newton matrix on (q, v, λ, μ) at c_j (w and d eliminated as in the
+  // unconstrained solve):
+  //   [ c_j I + H_μ      −I            0    Gᵀ ]
+  //   [ K + H_λ          c_j M + C     Gᵀ   0  ]   (constrained momentum rows: c_j e_cᵀ)
+  //   [ G                0             0    0  ]
+  //   [ D                G             0    0  ]
+  int ggl_factorize() {
+    const Index n = n_, N = 2 * n + 2 * m_;
+    const DofMap& dofs = sys_->dofs();
+    std::vector<Trip> t;
+    const SparsePattern& P = *newton_->K.pattern;
+    for (Index i = 0; i < n; ++i) {
+      t.emplace_back(i, i, cj_);
+      t.emplace_back(i, n + i, -1.0);
+    }
+    for (Index j = 0; j < P.n; ++j)
+      for (Index k = P.colptr[j]; k < P.colptr[j + 1]; ++k) {
+        const Index i = P.rowind[k];
+        if (Hm_.values[k] != 0.0) t.emplace_back(i, j, Hm_.values[k]);
+        if (dofs.is_constrained(i)) continue;
+        const double kq = newton_->K.values[k] + Hl_.values[k];
+        const double kv = cj_ * newton_->M.values[k] + newton_->G.values[k];
+        if (kq != 0.0) t.emplace_back(n + i, j, kq);
+        if (kv != 0.0) t.emplace_back(n + i, n + j, kv);
+      }
+    for (Index c : dofs.constrained_dofs()) t.emplace_back(n + c, n + c, cj_);
+    for (Index r = 0; r < Gj_.outerSize(); ++r)
+      for (SemiDiscreteSystem::ConstraintMatrix::InnerIterator it(Gj_, r); it; ++it) {
+        t.emplace_back(it.col(), 2 * n + m_ + r, it.value());  // Gᵀ μ in the q rows
+        t.emplace_back(n + it.col(), 2 * n + r, it.value());   // Gᵀ λ in the v rows
+        t.emplace_back(2 * n + r, it.col(), it.value());       // g
+        t.emplace_back(2 * n + m_ + r, n + it.col(), it.value());  // G v
+      }
+    for (const Trip& d : D_) t.emplace_back(2 * n + m_ + d.row(), d.col(), d.value());
+    SpMat A(N, N);
+    A.setFromTriplets(t.begin(), t.end());
+    A.makeCompressed();
+    lu_.compute(A);
+    ++ggl_factorizations_;
+    cj_fact_ = cj_;
+    if (lu_.info() != Eigen::Success) {
+      errors_.capture("ida-bdf GGL Newton-matrix factorization: singular (redundant joints?)");
+      return SUNLS_PACKAGE_FAIL_REC;
+    }
+    return SUNLS_SUCCESS;
+  }
+
+  int ggl_solve(const double* b, double* x) {
+    const Index n = n_, k0 = fos_->size();
+    Eigen::VectorXd rhs(2 * n + 2 * m_);
+    rhs.head(2 * n) = Eigen::Map<const Eigen::VectorXd>(b, 2 * n);
+    rhs.tail(2 * m_) = Eigen::Map<const Eigen::VectorXd>(b + k0, 2 * m_);
+    const Eigen::VectorXd z = lu_.solve(rhs);
+    std::copy(z.data(), z.data() + 2 * n, x);
+    std::copy(z.data() + 2 * n, z.data() + 2 * n + 2 * m_, x + k0);
+    const Eigen::Map<const Eigen::VectorXd> xv(x + n, n);
+    const double g = 1.0 / cj_fact_;
+    x[2 * n] = g * (b[2 * n] + fext_.dot(xv));
+    x[2 * n + 1] = g * (b[2 * n + 1] + 2.0 * cv_.dot(xv));
+    return all_finite(x, k0 + 2 * m_) ? SUNLS_SUCCESS : SUNLS_PACKAGE_FAIL_REC;
+  }
+
+  // Consistent initial values (ida_bdf.hpp): μ = 0, and (v̇, λ) from
+  //   M v̇ + Gᵀλ = F_ext − F_int − F_m,   G v̇ = −d/dt(G v + ∂g/∂t)|_{v̇ = 0}
+  // (the time derivative along (q + εv, t + ε) by central differences), supported DOFs v̇_c = 0.
+  void ggl_initial(const State& s, Eigen::VectorXd& a, Eigen::VectorXd& lambda) {
+    const Index n = n_;
+    const DofMap& dofs = sys_->dofs();
+    Eigen::VectorXd r;
+    fos_->momentum_residual(s.t, s, Eigen::VectorXd::Zero(n), r);  // F_m + F_int − F_ext (0 on supported rows)
+    const SparseMatrix& M = fos_->last_mass();
+    SemiDiscreteSystem::ConstraintMatrix G;
+    sys_->constraint_jacobian(s.t, s.u, s.charts, G);
+    double vmax = 1.0;
+    for (Index i = 0; i < n; ++i) vmax = std::max(vmax, std::abs(s.v[i]));
+    const double eps = 1e-5 / vmax;
+    auto phi = [&](double e) {
+      const Eigen::VectorXd u = s.u + e * s.v;
+      SemiDiscreteSystem::ConstraintMatrix Ge;
+      Eigen::VectorXd gt;
+      sys_->constraint_jacobian(s.t + e, u, s.charts, Ge);
+      sys_->constraint_time_derivative(s.t + e, u, s.charts, gt);
+      return Eigen::VectorXd(Ge * s.v + gt);
+    };
+    const Eigen::VectorXd gamma = -(phi(eps) - phi(-eps)) / (2.0 * eps);
+    std::vector<Trip> t;
+    const SparsePattern& P = *M.pattern;
+    for (Index j = 0; j < P.n; ++j)
+      for (Index k = P.colptr[j]; k < P.colptr[j + 1]; ++k) {
+        const Index i = P.rowind[k];
+        if (dofs.is_constrained(i) || dofs.is_constrained(j)) continue;
+        if (M.values[k] != 0.0) t.emplace_back(i, j, M.values[k]);
+      }
+    for (Index c : dofs.constrained_dofs()) t.emplace_back(c, c, 1.0);
+    for (Index row = 0; row < G.outerSize(); ++row)
+      for (SemiDiscreteSystem::ConstraintMatrix::InnerIterator it(G, row); it; ++it) {
+        t.emplace_back(it.col(), n + row, it.value());
+        t.emplace_back(n + row, it.col(), it.value());
+      }
+    SpMat A(n + m_, n + m_);
+    A.setFromTriplets(t.begin(), t.end());
+    Eigen::SparseLU<SpMat> lu(A);
+    if (lu.info() != Eigen::Success)
+      throw std::invalid_argument("ida-bdf: the initial constraint Jacobian and mass matrix give a singular system "
+                                  "(redundant joints, or a joint on massless unknowns)");
+    Eigen::VectorXd rhs(n + m_);
+    rhs.head(n) = -r;
+    for (Index c : dofs.constrained_dofs()) rhs[c] = 0.0;
+    rhs.tail(m_) = gamma;
+    const Eigen::VectorXd z = lu.solve(rhs);
+    a = z.head(n);
+    lambda = z.tail(m_);
   }
 
   static int root(sunrealtype, N_Vector y, N_Vector, sunrealtype* g, void* ud) {
@@ -363,6 +571,15 @@ class IdaBdf final : public SundialsBaseline {
   long request_steps_ = -1, request_conv_fails_ = -1, request_err_fails_ = -1;  // at the last Jacobian request
   Eigen::VectorXd a_, r_, fext_, cv_, rq_, p_;
   IdaCounters base_;
+  // GGL (m_ > 0)
+  Index m_ = 0;
+  NVectorPtr atol_all_;
+  SemiDiscreteSystem::ConstraintMatrix Gc_, Gj_;
+  SparseMatrix Hl_, Hm_;
+  std::vector<Trip> D_;
+  Eigen::SparseLU<SpMat> lu_;
+  double cj_fact_ = 1.0;
+  long ggl_factorizations_ = 0;
 };
 
 }  // namespace

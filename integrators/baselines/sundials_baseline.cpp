@@ -62,6 +62,10 @@ void SundialsBaseline::initialize(SemiDiscreteSystem& system, State& state) {
   if (system.has_prescribed_motion())
     throw std::invalid_argument(name_ + ": prescribed displacement histories (prescribed_displacements) are not supported "
                                         "by this integrator (use em-galpha, em-exact, galpha, midpoint or newmark)");
+  // Joints: only ida-bdf carries them (GGL, ida_bdf.hpp); the explicit ARKODE baselines would drift off them.
+  if (system.num_constraints() > 0 && !supports_constraints())
+    throw std::invalid_argument(name_ + ": cannot enforce joints (" + std::to_string(system.num_constraints()) +
+                                " constraint rows); use ida-bdf or a conserving integrator that supports them");
   sys_ = &system;
   n_ = system.num_dofs();
   if (!ctx_) ctx_ = std::make_unique<SunContext>();  // one context per integrator object

@@ -113,6 +113,30 @@ const BadCase kBadCases[] = {
     {"bad boolean", kMinimal + "output: {vtu: maybe}\n", "bad.yaml:6: output.vtu:", "expected true or false"},
     {"YAML syntax error", kMinimal + "sets: {A: [1, 2\n", "bad.yaml:", "YAML syntax error"},
     {"path-like case name", replace_line(kMinimal, 1, "name: ../evil"), "bad.yaml:1: name:", "not a valid name"},
+    // Rigid bodies and joints (docs/manual.md §2.13); the mesh-dependent checks are in tests/bad_input.
+    {"joint on an unknown body",
+     kMinimal + "rigid_bodies:\n  hub: {mass: 1, inertia: [1, 1, 1]}\njoints:\n  - {name: p, type: fixed_point, body: wheel, at: [0, 0, 0]}\n",
+     "bad.yaml:9: joints[0].body:", "unknown rigid body 'wheel' (defined: hub)"},
+    {"joint end on an unknown body",
+     kMinimal + "joints:\n  - {name: b, type: spherical, a: {set: all}, b: {body: hub, at: [0, 0, 0]}}\n",
+     "bad.yaml:7: joints[0].b.body:", "unknown rigid body 'hub' (define it under rigid_bodies:)"},
+    {"non-positive body mass", kMinimal + "rigid_bodies:\n  hub: {mass: -1, inertia: [1, 1, 1]}\n",
+     "bad.yaml:7: rigid_bodies.hub.mass:", "must be > 0"},
+    {"inertias violating the triangle inequality", kMinimal + "rigid_bodies:\n  hub: {mass: 1, inertia: [3, 1, 1]}\n",
+     "bad.yaml:7: rigid_bodies.hub.inertia:", "J1 = 3 exceeds J2 + J3"},
+    {"body axes not orthonormal", kMinimal + "rigid_bodies:\n  hub: {mass: 1, inertia: [1, 1, 1], axes: [[1, 0, 0], [1, 1, 0]]}\n",
+     "bad.yaml:7: rigid_bodies.hub.axes:", "unit vectors normal to each other"},
+    {"duplicate joint name",
+     kMinimal + "joints:\n  - {name: p, type: fixed_point, set: all}\n  - {name: p, type: fixed_point, set: all}\n",
+     "bad.yaml:8: joints[1].name:", "used twice"},
+    {"unknown joint type", kMinimal + "joints:\n  - {name: p, type: weld, set: all}\n", "bad.yaml:7: joints[0].type:",
+     "unknown value 'weld'"},
+    {"revolute without an axis",
+     kMinimal + "joints:\n  - {name: h, type: revolute, a: {set: all}, b: {ground: [0, 0, 0]}}\n", "bad.yaml:7: joints[0].axis:",
+     "missing required key 'axis'"},
+    {"joint end of two kinds",
+     kMinimal + "joints:\n  - {name: b, type: spherical, a: {set: all, ground: [0, 0, 0]}, b: {ground: [0, 0, 0]}}\n",
+     "bad.yaml:7: joints[0].a.ground:", "unknown key"},
 };
 
 INSTANTIATE_TEST_SUITE_P(CaseFile, BadCaseFile, ::testing::ValuesIn(kBadCases),
@@ -268,3 +292,41 @@ TEST(BenchmarkCases, PinchedHemisphereMatchesSection3) {
 }
 
 }  // namespace
+
+TEST(CaseFile, RigidBodiesJointsAndGravity) {
+  const CaseSpec c = load_case_from_string(
+      kMinimal + "gravity: [0, 0, -9.81]\n"
+                 "rigid_bodies:\n"
+                 "  hub: {mass: 2, inertia: [0.1, 0.1, 0.2], position: [1, 2, 3], axes: [[0, 1, 0], [0, 0, 1]],\n"
+                 "        velocity: [1, 0, 0], angular_velocity: [0, 0, 3]}\n"
+                 "joints:\n"
+                 "  - {name: pin, type: fixed_point, body: hub, at: [1, 2, 2]}\n"
+                 "  - {name: ball, type: spherical, a: {set: all}, b: {ground: [0, 0, 0]}}\n"
+                 "  - {name: hinge, type: revolute, a: {body: hub, at: [1, 2, 3]}, b: {ground: [1, 2, 3]}, axis: [0, 0, 2]}\n"
+                 "  - {name: clamp, type: rigid_connection, set: all, body: hub}\n"
+                 "  - {name: drive, type: prescribed_rotation, body: hub, point: [1, 2, 3], axis: [0, 0, 1],\n"
+                 "     angle: {type: ramp, t1: 2}, amplitude: 3}\n",
+      "mb.yaml");
+  EXPECT_EQ(c.gravity, Eigen::Vector3d(0, 0, -9.81));
+  ASSERT_FALSE(c.loads.empty());  // gravity on the shell: a gravity load on `all`
+  EXPECT_EQ(c.loads.back().type, LoadType::Gravity);
+  EXPECT_EQ(c.loads.back().set, "all");
+  EXPECT_EQ(c.loads.back().amplitude * c.loads.back().direction, Eigen::Vector3d(0, 0, -9.81));
+  ASSERT_EQ(c.rigid_bodies.size(), 1u);
+  const RigidBodySpec& b = c.rigid_bodies[0];
+  EXPECT_EQ(b.name, "hub");
+  EXPECT_EQ(b.mass, 2.0);
+  EXPECT_EQ(b.position, Eigen::Vector3d(1, 2, 3));
+  EXPECT_EQ(b.axes.col(2), Eigen::Vector3d(1, 0, 0));  // d3 = d1 × d2
+  EXPECT_EQ(b.angular_velocity, Eigen::Vector3d(0, 0, 3));
+  ASSERT_EQ(c.joints.size(), 5u);
+  EXPECT_EQ(c.joints[0].a.kind, JointEndSpec::Kind::body);
+  EXPECT_EQ(c.joints[0].a.at, Eigen::Vector3d(1, 2, 2));
+  EXPECT_EQ(c.joints[1].a.kind, JointEndSpec::Kind::set);
+  EXPECT_EQ(c.joints[1].b.kind, JointEndSpec::Kind::ground);
+  EXPECT_EQ(c.joints[2].axis, Eigen::Vector3d(0, 0, 2));
+  EXPECT_EQ(c.joints[3].set, "all");
+  EXPECT_EQ(c.joints[3].body, "hub");
+  EXPECT_EQ(c.joints[4].amplitude, 3.0);
+  EXPECT_DOUBLE_EQ(c.joints[4].amplitude * c.joints[4].angle(1.0), 1.5);
+}
