@@ -196,11 +196,31 @@ VtuFields initial_fields(const Discretization& d) {
   return f;
 }
 
+// Rigid bodies, joints and the constraint count of a case with a multibody part (docs/manual.md "Rigid bodies
+// and joints").
+void print_multibody(std::ostream& out, const Model& model) {
+  const ModelMultibody* mb = model.multibody();
+  if (!mb) return;
+  out << "rigid bodies: " << mb->num_bodies() << "\n";
+  for (int b = 0; b < mb->num_bodies(); ++b) {
+    const RigidBodyDef& d = mb->body_def(b);
+    out << "  " << d.name << ": mass " << d.mass << ", inertia " << vec_text(d.inertia) << ", at " << vec_text(d.position)
+        << ", unknowns " << mb->body_first_dof(b) << ".." << mb->body_first_dof(b) + 11 << "\n";
+  }
+  out << "joints: " << mb->joints().size() << ", constraint rows: " << model.num_constraints() << "\n";
+  for (const auto& blk : model.constraint_blocks())
+    out << "  " << blk.name << ": " << blk.type << ", " << blk.rows << " rows (" << blk.first_row << ".."
+        << blk.first_row + blk.rows - 1 << ")\n";
+}
+
 int run_check(const CheckOptions& o) {
   const CaseSpec spec = load_case(resolve_case_path(o.case_path));
   validate_case_integrator(spec);  // exactly as `run` will (FILE:LINE: integrator.KEY: ...)
   const Discretization d = build_discretization(spec);
   VtuFields fields = initial_fields(d);
+  std::unique_ptr<Problem> multibody;
+  if (!spec.rigid_bodies.empty() || !spec.joints.empty())  // joints are checked on the model, as `run` will
+    multibody = std::make_unique<Problem>(make_problem(spec));
   if (!spec.initial_displacement.empty() || !d.prescribed.empty()) {  // validate as `run` will, show the displaced state
     const Problem pb = make_problem(spec);
     const State s = pb.initial_state();
@@ -212,6 +232,7 @@ int run_check(const CheckOptions& o) {
   const fs::path dir = o.out_dir.empty() ? fs::path("results") / spec.name : fs::path(o.out_dir);
   app::prepare_result_folder(dir.string(), o.overwrite);
   print_summary(std::cout, spec, d);
+  if (multibody) print_multibody(std::cout, *multibody->model);
   prepare_output_folder(dir.string());
   const std::string vtu = "fields/" + vtu_step_file_name(0);
   write_vtu((dir / vtu).string(), d.mesh, fields);

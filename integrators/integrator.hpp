@@ -103,6 +103,10 @@ class Integrator {
   // Whether the integrator follows prescribed displacement histories. Cases that have them are refused by
   // integrators that do not (integrators/runs/case_integrator.cpp), never run with the DOFs held at 0.
   virtual bool supports_prescribed_motion() const { return false; }
+  // Whether the integrator enforces holonomic constraints (joints: SemiDiscreteSystem::num_constraints() > 0,
+  // docs/reference/system-interface.md "Constraints"). The run driver refuses a constrained system with an
+  // integrator that does not, naming those that do (integrators/runs/run_driver.cpp).
+  virtual bool supports_constraints() const { return false; }
 
   // The scaled residuals ρ_k = ‖r(u_k)‖∞ / (largest entry of the step's inertial, internal and external forces)
   // of every iterate a Newton-based step evaluated, reported once per accepted step with the step's Newton

@@ -109,6 +109,24 @@ std::vector<std::string> integrator_names() {
   return names;
 }
 
+std::vector<std::string> integrators_supporting_constraints() {
+  std::vector<std::pair<std::string, Entry>> entries;
+  {
+    Registry& r = registry();
+    std::lock_guard<std::mutex> lock(r.mutex);
+    for (const auto& kv : r.entries) entries.emplace_back(kv.first, kv.second);
+  }
+  std::vector<std::string> out;
+  for (const auto& [name, entry] : entries) {
+    try {
+      IntegratorSettings probe(name, {});
+      if (entry.factory(probe, 1e-3)->supports_constraints()) out.push_back(name);
+    } catch (const std::exception&) {
+    }
+  }
+  return out;
+}
+
 std::vector<std::pair<std::string, std::string>> integrator_catalogue() {
   std::vector<std::pair<std::string, Entry>> entries;
   {

@@ -70,6 +70,10 @@ std::vector<std::pair<std::string, std::string>> settings_understood_by(
 // Names of every registered integrator (sorted), for --help and error messages.
 std::vector<std::string> integrator_names();
 
+// Names of the registered integrators that enforce constraints (Integrator::supports_constraints, from a probe
+// instance of each), sorted.
+std::vector<std::string> integrators_supporting_constraints();
+
 // (name, one-line summary + the settings it reads with their defaults) of every registered integrator.
 std::vector<std::pair<std::string, std::string>> integrator_catalogue();
 

@@ -307,6 +307,15 @@ RunSummary run_dynamic(Problem& problem, const RunOptions& o) {
   const std::string origin = integrator_origin(registered_name);
   const std::optional<PluginInfo> plugin = plugin_of_integrator(registered_name);
   const std::string blame = origin == "built-in" ? std::string() : "integrator '" + registered_name + "' from " + origin + ": ";
+  // Joints (docs/reference/system-interface.md "Constraints"): an integrator that does not enforce them must not
+  // run the system as if they were absent.
+  if (model.num_constraints() > 0 && !integrator->supports_constraints()) {
+    std::string able;
+    for (const auto& n : integrators_supporting_constraints()) able += (able.empty() ? "" : ", ") + n;
+    throw std::invalid_argument("integrator '" + integrator->name() + "' does not enforce joints, and the case has " +
+                                std::to_string(model.num_constraints()) + " constraint rows (joints, rigid-body frames); use " +
+                                (able.empty() ? std::string("an integrator that does (none is registered)") : "one of: " + able));
+  }
 
   RunSummary sum;
   sum.integrator = integrator->name();
@@ -349,6 +358,7 @@ RunSummary run_dynamic(Problem& problem, const RunOptions& o) {
   info.discretization.set("loads_end", problem.disc.loads_end);
   std::unique_ptr<HistoryWriter> history;
   std::unique_ptr<PvdWriter> pvd;
+  std::unique_ptr<std::ofstream> bodies_csv;
   const bool files = !o.out_dir.empty();
   const std::string run_json_path = o.out_dir + "/run.json";
   const std::string checkpoint_path = o.out_dir + "/" + checkpoint_file_name();
@@ -367,11 +377,20 @@ RunSummary run_dynamic(Problem& problem, const RunOptions& o) {
     std::vector<std::string> extra;
     if (model.has_damping()) extra.push_back("damping_work");
     if (model.has_prescribed_motion()) extra.push_back("prescribed_work");
+    // g_norm = ‖g(u)‖∞, gdot_norm = ‖G u̇ + ∂g/∂t‖∞: constraint drift at the output state (joints only).
+    if (model.num_constraints() > 0) {
+      extra.push_back("g_norm");
+      extra.push_back("gdot_norm");
+    }
     if (spec.output.history)
       history = resume ? std::make_unique<HistoryWriter>(o.out_dir + "/history.csv", extra, names,
                                                          static_cast<long long>(resume->number("history_bytes")))
                        : std::make_unique<HistoryWriter>(o.out_dir + "/history.csv", extra, names);
     if (vtu_every > 0) pvd = std::make_unique<PvdWriter>(o.out_dir + "/fields.pvd");
+    if (model.num_rigid_bodies() > 0) {  // bodies.csv: the rigid bodies' states per output (docs/manual.md)
+      bodies_csv = std::make_unique<std::ofstream>(o.out_dir + "/bodies.csv", resume ? std::ios::app : std::ios::trunc);
+      if (!resume) *bodies_csv << body_state_header() << "\n";
+    }
   }
 
   // --- state and reference quantities ----------------------------------------------------------------
@@ -563,8 +582,14 @@ RunSummary run_dynamic(Problem& problem, const RunOptions& o) {
       row.monitors = mon;
       if (model.has_damping()) row.extra.push_back(integrator->damping_work());
       if (model.has_prescribed_motion()) row.extra.push_back(integrator->prescribed_work());
+      if (model.num_constraints() > 0) {
+        const auto [g_norm, gdot_norm] = constraint_drift(model, state);
+        row.extra.push_back(g_norm);
+        row.extra.push_back(gdot_norm);
+      }
       history->write(row);
     }
+    if (bodies_csv) write_body_states(*bodies_csv, model, state);
     if (vtu_now) {
       const std::string file = "fields/" + vtu_step_file_name(out_index);
       write_vtu(o.out_dir + "/" + file, model.mesh(), state_fields(model, state, &R));

@@ -9,6 +9,8 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <Eigen/Geometry>
+
 #include <algorithm>
 #include <cctype>
 #include <cmath>
@@ -606,11 +608,155 @@ std::vector<MonitorSpec> parse_monitors(const Parser& p, const YAML::Node& n) {
   return monitors;
 }
 
+// ---- rigid bodies and joints (docs/manual.md "Rigid bodies and joints") ----------------------------------
+std::vector<RigidBodySpec> parse_rigid_bodies(const Parser& p, const YAML::Node& n) {
+  if (!n.IsMap() || n.size() == 0)
+    p.fail(n, "rigid_bodies", "expected a mapping NAME: {mass, inertia, ...} with at least one body, got a " + node_kind(n));
+  std::vector<RigidBodySpec> out;
+  for (const auto& kv : n) {
+    const std::string path = "rigid_bodies." + kv.first.Scalar();
+    RigidBodySpec b;
+    b.name = p.name(kv.first, path);
+    const YAML::Node m = kv.second;
+    if (!m.IsMap()) p.fail(m, path, "expected a mapping {mass, inertia, [position], [axes], [velocity], [angular_velocity]}");
+    p.check_keys(m, path, {"mass", "inertia", "position", "axes", "velocity", "angular_velocity"}, {"mass", "inertia"});
+    b.where = p.where(m, path);
+    b.mass = p.number(m["mass"], path + ".mass");
+    if (!(b.mass > 0.0)) p.fail(m["mass"], path + ".mass", "must be > 0, got " + m["mass"].Scalar() + " (a body needs a mass)");
+    b.inertia = p.vec3(m["inertia"], path + ".inertia");
+    for (int k = 0; k < 3; ++k)
+      if (!(b.inertia[k] > 0.0))
+        p.fail(m["inertia"], path + ".inertia", "principal inertias must be > 0 (give J1, J2, J3 about the centre of mass)");
+    for (int i = 0; i < 3; ++i) {
+      const int j = (i + 1) % 3, k = (i + 2) % 3;
+      if (b.inertia[i] > b.inertia[j] + b.inertia[k])
+        p.fail(m["inertia"], path + ".inertia",
+               "J" + std::to_string(i + 1) + " = " + m["inertia"][i].Scalar() + " exceeds J" + std::to_string(j + 1) + " + J" +
+                   std::to_string(k + 1) + ": no body has these principal inertias (triangle inequality)");
+    }
+    if (m["position"]) b.position = p.vec3(m["position"], path + ".position");
+    if (m["velocity"]) b.velocity = p.vec3(m["velocity"], path + ".velocity");
+    if (m["angular_velocity"]) b.angular_velocity = p.vec3(m["angular_velocity"], path + ".angular_velocity");
+    if (m["axes"]) {
+      const YAML::Node a = m["axes"];
+      if (!a.IsSequence() || a.size() != 2) p.fail(a, path + ".axes", "expected [d1, d2], two orthonormal 3-vectors");
+      const Eigen::Vector3d d1 = p.vec3(a[0], path + ".axes[0]"), d2 = p.vec3(a[1], path + ".axes[1]");
+      if (std::abs(d1.norm() - 1.0) > 1e-6 || std::abs(d2.norm() - 1.0) > 1e-6 || std::abs(d1.dot(d2)) > 1e-6)
+        p.fail(a, path + ".axes", "d1 and d2 must be unit vectors normal to each other (to 1e-6)");
+      // Orthonormalized to round-off, so the frame constraints hold at t = 0 (multibody.md (3.3)).
+      const Eigen::Vector3d e1 = d1.normalized(), e2 = (d2 - d2.dot(e1) * e1).normalized();
+      b.axes.col(0) = e1;
+      b.axes.col(1) = e2;
+      b.axes.col(2) = e1.cross(e2);
+    }
+    out.push_back(std::move(b));
+  }
+  return out;
+}
+
+JointEndSpec parse_joint_end(const Parser& p, const YAML::Node& n, const std::string& path,
+                             const std::vector<RigidBodySpec>& bodies) {
+  JointEndSpec e;
+  e.where = p.where(n, path);
+  if (!n.IsMap()) p.fail(n, path, "expected {set: S} | {body: B, at: [x,y,z]} | {ground: [x,y,z]}, got a " + node_kind(n));
+  if (n["set"]) {
+    p.check_keys(n, path, {"set"}, {"set"});
+    e.kind = JointEndSpec::Kind::set;
+    e.set = p.string(n["set"], path + ".set");
+  } else if (n["body"]) {
+    p.check_keys(n, path, {"body", "at"}, {"body", "at"});
+    e.kind = JointEndSpec::Kind::body;
+    e.body = p.string(n["body"], path + ".body");
+    e.at = p.vec3(n["at"], path + ".at");
+  } else if (n["ground"]) {
+    p.check_keys(n, path, {"ground"}, {"ground"});
+    e.kind = JointEndSpec::Kind::ground;
+    e.at = p.vec3(n["ground"], path + ".ground");
+  } else {
+    p.fail(n, path, "expected one of {set: S}, {body: B, at: [x,y,z]} or {ground: [x,y,z]}");
+  }
+  if (e.kind == JointEndSpec::Kind::body) {
+    std::vector<std::string> names;
+    for (const auto& b : bodies) names.push_back(b.name);
+    if (std::find(names.begin(), names.end(), e.body) == names.end())
+      p.fail(n["body"], path + ".body",
+             "unknown rigid body '" + e.body + "' (" + (names.empty() ? std::string("define it under rigid_bodies:") : "defined: " + join(names)) + ")");
+  }
+  return e;
+}
+
+std::vector<JointSpec> parse_joints(const Parser& p, const YAML::Node& n, const std::vector<RigidBodySpec>& bodies) {
+  p.require_sequence(n, "joints", "joint entries");
+  std::vector<JointSpec> out;
+  std::vector<std::string> body_names;
+  for (const auto& b : bodies) body_names.push_back(b.name);
+  auto body_ref = [&](const YAML::Node& at, const std::string& path) {
+    const std::string b = p.string(at, path);
+    if (std::find(body_names.begin(), body_names.end(), b) == body_names.end())
+      p.fail(at, path, "unknown rigid body '" + b + "' (" +
+                           (body_names.empty() ? std::string("define it under rigid_bodies:") : "defined: " + join(body_names)) + ")");
+    return b;
+  };
+  for (size_t k = 0; k < n.size(); ++k) {
+    const std::string path = "joints[" + std::to_string(k) + "]";
+    const YAML::Node j = n[k];
+    if (!j.IsMap()) p.fail(j, path, "expected a mapping {name, type, ...}, got a " + node_kind(j));
+    if (!j["type"])
+      p.fail(j, path + ".type", "missing required key 'type' (fixed_point, spherical, revolute, rigid_connection or prescribed_rotation)");
+    JointSpec s;
+    s.where = p.where(j, path);
+    const std::vector<std::string> types = {"fixed_point", "spherical", "revolute", "rigid_connection", "prescribed_rotation"};
+    s.type = types[p.choice(j["type"], path + ".type", types)];
+    if (s.type == "fixed_point") {
+      p.check_keys(j, path, {"name", "type", "set", "body", "at"}, {"name", "type"});
+      if (j["set"] && !j["body"] && !j["at"]) {
+        s.a.kind = JointEndSpec::Kind::set;
+        s.a.set = p.string(j["set"], path + ".set");
+      } else if (j["body"] && j["at"] && !j["set"]) {
+        s.a.kind = JointEndSpec::Kind::body;
+        s.a.body = body_ref(j["body"], path + ".body");
+        s.a.at = p.vec3(j["at"], path + ".at");
+      } else {
+        p.fail(j, path, "a fixed_point needs either `set` (a one-node set) or `body` and `at`");
+      }
+      s.a.where = s.where;
+    } else if (s.type == "spherical" || s.type == "revolute") {
+      if (s.type == "spherical") p.check_keys(j, path, {"name", "type", "a", "b"}, {"name", "type", "a", "b"});
+      else p.check_keys(j, path, {"name", "type", "a", "b", "axis"}, {"name", "type", "a", "b", "axis"});
+      s.a = parse_joint_end(p, j["a"], path + ".a", bodies);
+      s.b = parse_joint_end(p, j["b"], path + ".b", bodies);
+      if (s.type == "revolute") {
+        s.axis = p.vec3(j["axis"], path + ".axis");
+        if (!(s.axis.norm() > 0.0)) p.fail(j["axis"], path + ".axis", "must not be the zero vector");
+      }
+    } else if (s.type == "rigid_connection") {
+      p.check_keys(j, path, {"name", "type", "set", "body"}, {"name", "type", "set", "body"});
+      s.set = p.string(j["set"], path + ".set");
+      s.body = body_ref(j["body"], path + ".body");
+    } else {
+      p.check_keys(j, path, {"name", "type", "body", "point", "axis", "angle", "amplitude"},
+                   {"name", "type", "body", "point", "axis", "angle"});
+      s.body = body_ref(j["body"], path + ".body");
+      s.point = p.vec3(j["point"], path + ".point");
+      s.axis = p.vec3(j["axis"], path + ".axis");
+      if (!(s.axis.norm() > 0.0)) p.fail(j["axis"], path + ".axis", "must not be the zero vector");
+      s.angle = parse_function(p, j["angle"], path + ".angle");
+      if (j["amplitude"]) s.amplitude = p.number(j["amplitude"], path + ".amplitude");
+    }
+    s.name = p.name(j["name"], path + ".name");
+    for (const auto& o : out)
+      if (o.name == s.name) p.fail(j["name"], path + ".name", "joint name '" + s.name + "' is used twice (names must be unique)");
+    out.push_back(std::move(s));
+  }
+  return out;
+}
+
 CaseSpec parse_document(const Parser& p, const YAML::Node& root, const std::string& base_dir) {
   if (!root.IsDefined() || root.IsNull()) p.fail(root, "", "the case file is empty (see apps/cases/ for examples)");
   p.check_keys(root, "",
                {"name", "description", "mesh", "material", "sets", "boundary_conditions", "initial_velocity", "initial_displacement", "loads",
-                "prescribed_displacements", "damping", "integrator", "time", "output", "monitors", "plugins"},
+                "prescribed_displacements", "damping", "integrator", "time", "output", "monitors", "plugins",
+                "gravity", "rigid_bodies", "joints"},
                {"mesh", "material", "integrator", "time"});
   CaseSpec c;
   c.source = p.source();
@@ -663,6 +809,20 @@ CaseSpec parse_document(const Parser& p, const YAML::Node& root, const std::stri
              "the initial velocity must then be a field (e.g. the same VTU), not a rigid motion or mode");
   }
   if (root["loads"]) c.loads = parse_loads(p, root["loads"]);
+  if (root["gravity"]) {  // uniform gravity: a gravity load on the whole shell, m g on the bodies
+    c.gravity = p.vec3(root["gravity"], "gravity");
+    if (c.gravity.norm() > 0.0) {
+      LoadSpec g;
+      g.set = "all";
+      g.type = LoadType::Gravity;
+      g.direction = c.gravity;
+      g.amplitude = 1.0;
+      g.where = p.where(root["gravity"], "gravity");
+      c.loads.push_back(std::move(g));
+    }
+  }
+  if (root["rigid_bodies"]) c.rigid_bodies = parse_rigid_bodies(p, root["rigid_bodies"]);
+  if (root["joints"]) c.joints = parse_joints(p, root["joints"], c.rigid_bodies);
   if (root["prescribed_displacements"]) c.prescribed_displacements = parse_prescribed(p, root["prescribed_displacements"]);
   if (root["damping"]) c.damping = parse_damping(p, root["damping"]);
   c.integrator = parse_integrator(p, root["integrator"]);

@@ -35,6 +35,9 @@
 //          | {[set = all], type: body_force|gravity, direction, amplitude, [function]}, ...]   optional
 //   prescribed_displacements: [{set, dofs: [ux|uy|uz, ...], value, [function]}, ...]  optional
 //   damping: {[mass = 0], [stiffness = 0]}                                             optional
+//   gravity: [gx, gy, gz]              uniform gravity on the shell and the rigid bodies         optional
+//   rigid_bodies: {NAME: {mass, inertia: [J1,J2,J3], [position], [axes: [d1, d2]], [velocity], [angular_velocity]}}
+//   joints: [{name, type: fixed_point|spherical|revolute|rigid_connection|prescribed_rotation, ...}]  optional
 // The full reference with types, defaults and units is docs/manual.md.
 //   integrator: {name, ...settings}    settings kept as ordered (key, scalar text) pairs
 //   time: {dt, t_end, [output_interval = dt]}
@@ -230,6 +233,38 @@ struct MonitorSpec {
   std::string where;
 };
 
+// Rigid bodies and joints (docs/manual.md "Rigid bodies and joints"; docs/theory/multibody.md §3, §4).
+struct RigidBodySpec {
+  std::string name;
+  double mass = 0.0;
+  Eigen::Vector3d inertia = Eigen::Vector3d::Zero();  // principal inertias about the centre of mass
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();  // centre of mass at t = 0
+  Eigen::Matrix3d axes = Eigen::Matrix3d::Identity();  // columns d1, d2, d3 = d1 × d2 at t = 0
+  Eigen::Vector3d velocity = Eigen::Vector3d::Zero(), angular_velocity = Eigen::Vector3d::Zero();
+  std::string where;
+};
+// One end of a joint: {set: S} (a one-node set), {body: B, at: [x,y,z]} (the body's point at x at t = 0) or
+// {ground: [x,y,z]}.
+struct JointEndSpec {
+  enum class Kind { none, set, body, ground };
+  Kind kind = Kind::none;
+  std::string set, body;
+  Eigen::Vector3d at = Eigen::Vector3d::Zero();
+  std::string where;
+};
+struct JointSpec {
+  std::string name;
+  std::string type;  // fixed_point, spherical, revolute, rigid_connection, prescribed_rotation
+  JointEndSpec a, b;  // fixed_point: a; spherical, revolute: a and b
+  std::string set;    // rigid_connection: every node of the set
+  std::string body;   // rigid_connection, prescribed_rotation
+  Eigen::Vector3d axis = Eigen::Vector3d::UnitZ();   // revolute, prescribed_rotation (space, t = 0)
+  Eigen::Vector3d point = Eigen::Vector3d::Zero();   // prescribed_rotation
+  TimeFunction angle;                                 // prescribed_rotation: θ(t) = amplitude · angle(t) [rad]
+  double amplitude = 1.0;
+  std::string where;
+};
+
 struct CaseSpec {
   std::string name;
   std::string description;
@@ -253,6 +288,11 @@ struct CaseSpec {
   TimeSpec time;
   OutputSpec output;
   std::vector<MonitorSpec> monitors;
+  // gravity: [gx, gy, gz]: uniform gravity on the shell (a gravity load on `all`, added to `loads`) and on the
+  // rigid bodies (m g). Zero if absent.
+  Eigen::Vector3d gravity = Eigen::Vector3d::Zero();
+  std::vector<RigidBodySpec> rigid_bodies;
+  std::vector<JointSpec> joints;
   // plugins: [PATH.so, ...]: shared libraries that register integrators, loaded before the integrator is made
   // (integrators/runs/plugin.hpp); relative paths are resolved against base_dir. plugins_where: "FILE:LINE: plugins".
   std::vector<std::string> plugins;

@@ -2,7 +2,9 @@
 
 #include "lib/io/vtu_reader.hpp"
 
+#include <Eigen/Geometry>
 #include <algorithm>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -128,6 +130,44 @@ void prepare_output_folder(const std::string& dir) {
     if (!out) throw std::runtime_error("output folder '" + dir + "' is not writable");
   }
   fs::remove(probe, ec);
+}
+
+std::pair<double, double> constraint_drift(const SemiDiscreteSystem& system, const State& state) {
+  if (system.num_constraints() == 0) return {0.0, 0.0};
+  Eigen::VectorXd g, gt;
+  SemiDiscreteSystem::ConstraintMatrix G;
+  system.constraint_values(state.t, state.u, state.charts, g);
+  system.constraint_jacobian(state.t, state.u, state.charts, G);
+  system.constraint_time_derivative(state.t, state.u, state.charts, gt);
+  const Eigen::VectorXd gdot = G * state.v + gt;
+  return {g.size() ? g.cwiseAbs().maxCoeff() : 0.0, gdot.size() ? gdot.cwiseAbs().maxCoeff() : 0.0};
+}
+
+std::string body_state_header() {
+  return "t,body,phi_x,phi_y,phi_z,d1_x,d1_y,d1_z,d2_x,d2_y,d2_z,d3_x,d3_y,d3_z,v_x,v_y,v_z,omega_x,omega_y,omega_z";
+}
+
+void write_body_states(std::ostream& out, const Model& model, const State& state) {
+  const ModelMultibody* mb = model.multibody();
+  if (!mb) return;
+  char buf[64];
+  auto put = [&](double x) {
+    std::snprintf(buf, sizeof buf, ",%.17g", x);
+    out << buf;
+  };
+  for (int b = 0; b < mb->num_bodies(); ++b) {
+    const multibody::Vec12 q = mb->body_q(b, state.u);
+    const multibody::Vec12 qd = state.v.segment<12>(mb->body_first_dof(b));
+    std::snprintf(buf, sizeof buf, "%.17g", state.t);
+    out << buf << "," << mb->body_def(b).name;
+    for (int k = 0; k < 12; ++k) put(q[k]);
+    for (int k = 0; k < 3; ++k) put(qd[k]);
+    Eigen::Vector3d w = Eigen::Vector3d::Zero();
+    for (int i = 0; i < 3; ++i) w += 0.5 * Eigen::Vector3d(q.segment<3>(3 + 3 * i)).cross(Eigen::Vector3d(qd.segment<3>(3 + 3 * i)));
+    for (int k = 0; k < 3; ++k) put(w[k]);
+    out << "\n";
+  }
+  out.flush();
 }
 
 }  // namespace shelldyn

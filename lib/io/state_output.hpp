@@ -6,6 +6,10 @@
 #include "lib/model/state.hpp"
 #include "lib/io/vtu_writer.hpp"
 
+#include <ostream>
+#include <string>
+#include <utility>
+
 namespace shelldyn {
 
 // With `reactions` (lib/model/reactions.hpp) the point field "reaction" (3 components) is added. Cell data:
@@ -20,6 +24,16 @@ VtuFields state_fields(const Model& model, const State& state, const Eigen::Vect
 // the charts (Model::adopt_charts). Throws std::runtime_error "PATH: reason" for a file of another mesh,
 // a missing/non-finite array, a director that is not a unit vector, or a displaced fixed DOF.
 State state_from_vtu(const Model& model, const std::string& path, bool* has_time);
+
+// Constraint drift at a state (docs/manual.md "Rigid bodies and joints"): (‖g(u, t)‖∞, ‖G(u, t) u̇ + ∂g/∂t‖∞),
+// the history.csv columns g_norm and gdot_norm; (0, 0) without constraints.
+std::pair<double, double> constraint_drift(const SemiDiscreteSystem& system, const State& state);
+
+// bodies.csv: one row per rigid body per output, "t,body,phi_x,phi_y,phi_z,d1_x,..,d3_z,v_x,v_y,v_z,omega_x,
+// omega_y,omega_z" with the centre of mass φ, the body axes d_i, φ̇ and the spatial angular velocity
+// ω = ½ Σ d_i × ḋ_i (exact for an orthonormal frame with ḋ_i = ω × d_i).
+std::string body_state_header();
+void write_body_states(std::ostream& out, const Model& model, const State& state);
 
 // Creates `dir` and `dir/fields` (and parents). Throws std::runtime_error naming the folder when it
 // cannot be created or written to.

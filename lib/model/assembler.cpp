@@ -6,8 +6,10 @@
 
 namespace shelldyn {
 
-Assembler::Assembler(const std::vector<Quad9>& elements, int num_nodes) {
-  const Index n = static_cast<Index>(num_nodes) * kDofsPerNode;
+Assembler::Assembler(const std::vector<Quad9>& elements, int num_nodes, Index extra_dofs,
+                     const std::vector<std::vector<Index>>& couplings) {
+  const Index n_shell = static_cast<Index>(num_nodes) * kDofsPerNode;
+  const Index n = n_shell + extra_dofs;
   dofs_.resize(elements.size());
   for (size_t e = 0; e < elements.size(); ++e) {
     for (int a = 0; a < 9; ++a) {
@@ -41,6 +43,7 @@ Assembler::Assembler(const std::vector<Quad9>& elements, int num_nodes) {
       pattern_->colptr[static_cast<size_t>(col) + 1] = pattern_->colptr[static_cast<size_t>(col)] + col_len;
     }
   }
+  for (Index col = n_shell; col < n; ++col) pattern_->colptr[static_cast<size_t>(col) + 1] = pattern_->colptr[static_cast<size_t>(col)];
   pattern_->rowind.resize(static_cast<size_t>(pattern_->colptr.back()));
   for (int node = 0; node < num_nodes; ++node) {
     for (int c = 0; c < kDofsPerNode; ++c) {
@@ -48,6 +51,29 @@ Assembler::Assembler(const std::vector<Quad9>& elements, int num_nodes) {
       for (int other : node_adj[static_cast<size_t>(node)])
         for (int r = 0; r < kDofsPerNode; ++r) pattern_->rowind[static_cast<size_t>(pos++)] = DofMap::dof(other, r);
     }
+  }
+
+  if (!couplings.empty()) {  // merge the coupling groups' entries column by column
+    std::vector<std::vector<Index>> extra(static_cast<size_t>(n));
+    for (const auto& g : couplings)
+      for (Index c : g) {
+        if (c < 0 || c >= n) throw std::invalid_argument("Assembler: coupling on DOF " + std::to_string(c) + " outside the system");
+        for (Index r : g) extra[static_cast<size_t>(c)].push_back(r);
+      }
+    auto merged = std::make_shared<SparsePattern>();
+    merged->n = n;
+    merged->colptr.assign(static_cast<size_t>(n) + 1, 0);
+    std::vector<Index> rows;
+    for (Index col = 0; col < n; ++col) {
+      rows.assign(pattern_->rowind.begin() + pattern_->colptr[static_cast<size_t>(col)],
+                  pattern_->rowind.begin() + pattern_->colptr[static_cast<size_t>(col) + 1]);
+      rows.insert(rows.end(), extra[static_cast<size_t>(col)].begin(), extra[static_cast<size_t>(col)].end());
+      std::sort(rows.begin(), rows.end());
+      rows.erase(std::unique(rows.begin(), rows.end()), rows.end());
+      merged->rowind.insert(merged->rowind.end(), rows.begin(), rows.end());
+      merged->colptr[static_cast<size_t>(col) + 1] = static_cast<Index>(merged->rowind.size());
+    }
+    pattern_ = std::move(merged);
   }
 
   // Scatter maps: position of (row a, col b) of every element block, stored column-major.

@@ -26,7 +26,11 @@ using ElementMatrix = Eigen::Matrix<double, kElementDofs, kElementDofs>;
 
 class Assembler {
  public:
-  Assembler(const std::vector<Quad9>& elements, int num_nodes);
+  // extra_dofs unknowns follow the 5 per node (rigid bodies); `couplings` are groups of DOFs whose entries all
+  // couple (constraint tangents, body mass blocks: lib/model/model_multibody.hpp). Without either, the pattern is
+  // the element pattern alone.
+  Assembler(const std::vector<Quad9>& elements, int num_nodes, Index extra_dofs = 0,
+            const std::vector<std::vector<Index>>& couplings = {});
 
   std::shared_ptr<const SparsePattern> pattern() const { return pattern_; }
   Index num_dofs() const { return pattern_->n; }

@@ -33,7 +33,11 @@ class DofMap {
   explicit DofMap(int num_nodes);
 
   int num_nodes() const { return num_nodes_; }
-  Index num_dofs() const { return static_cast<Index>(num_nodes_) * kDofsPerNode; }
+  // 5 per node, then `extra` free unknowns (rigid bodies, lib/model/model_multibody.hpp) that no support fixes.
+  Index num_dofs() const { return static_cast<Index>(num_nodes_) * kDofsPerNode + extra_; }
+  Index num_extra() const { return extra_; }
+  // Sets the number of extra unknowns; takes effect at the next resolve().
+  void set_extra_dofs(Index extra) { extra_ = extra; }
   static Index dof(int node, int component) { return static_cast<Index>(node) * kDofsPerNode + component; }
 
   // Records a constraint; duplicates are ignored. Takes effect at the next resolve().
@@ -56,6 +60,7 @@ class DofMap {
     Fix what;
   };
   int num_nodes_;
+  Index extra_ = 0;
   std::vector<Constraint> constraints_;
   std::vector<char> constrained_mask_;
   std::vector<Index> constrained_;

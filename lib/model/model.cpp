@@ -10,6 +10,7 @@
 #include <cstring>
 #include <exception>
 #include <mutex>
+#include <limits>
 #include <optional>
 
 #include <omp.h>
@@ -108,6 +109,8 @@ State Model::initial_state() const {
     s.charts[i] = select_chart(normals_[i]);
     s.u.segment<2>(DofMap::dof(static_cast<int>(i), 3)) = chart_coordinates(normals_[i], s.charts[i]);
   }
+  if (mb_)  // bodies start at u_b = 0 (q_b = q_b(0)) with φ̇ = v, ḋ_i = ω × d_i
+    for (int b = 0; b < mb_->num_bodies(); ++b) s.v.segment<12>(mb_->body_first_dof(b)) = mb_->body_initial_velocity(b);
   return s;
 }
 
@@ -199,6 +202,14 @@ void Model::mass(const Eigen::VectorXd& u, const std::vector<DirectorChart>& cha
     elements_[static_cast<size_t>(e)].mass(ue, element_charts(e, charts), &me);
     assembler_.add_matrix(e, me, M.values.data());
   });
+  if (mb_)  // constant body blocks diag(m I, E1 I, E2 I, E3 I) (multibody.md §3)
+    for (int b = 0; b < mb_->num_bodies(); ++b) {
+      const multibody::Vec12 m = mb_->body(b).mass_diagonal();
+      for (int k = 0; k < 12; ++k) {
+        const Index d = mb_->body_first_dof(b) + k;
+        M.values[static_cast<size_t>(assembler_.find(d, d))] += m[k];
+      }
+    }
 }
 
 void Model::inertial(const Eigen::VectorXd& u, const Eigen::VectorXd& v, const std::vector<DirectorChart>& charts,
@@ -227,6 +238,12 @@ void Model::inertia_force(const Eigen::VectorXd& u, const Eigen::VectorXd& v, co
     elements_[static_cast<size_t>(e)].inertia_force(ue, ve, ae, element_charts(e, charts), &fe);
     assembler_.add_vector(e, fe, out);
   });
+  if (mb_)  // bodies: M_b a_b (constant mass, no F_m)
+    for (int b = 0; b < mb_->num_bodies(); ++b) {
+      const Index k = mb_->body_first_dof(b);
+      const multibody::Vec12 m = mb_->body(b).mass_diagonal();
+      for (int j = 0; j < 12; ++j) out[k + j] += m[j] * a[k + j];
+    }
   if (has_damping()) add_damping(v, out);
 }
 
@@ -249,6 +266,9 @@ void Model::external(double t, const Eigen::VectorXd& u, const std::vector<Direc
     }
   }
   if (!follower_.empty()) add_follower_pressures(follower_, mesh_, assembler_, t, u, F, nullptr, false);
+  if (mb_)  // uniform gravity on the bodies: m g on φ (its potential −m g·φ is linear, multibody.md §3)
+    for (int b = 0; b < mb_->num_bodies(); ++b)
+      for (int c = 0; c < 3; ++c) F[mb_->body_first_dof(b) + c] += mb_->body(b).mass() * mb_->gravity()[c];
 }
 
 void Model::add_load_stiffness(double t, const Eigen::VectorXd& u, const std::vector<DirectorChart>& charts,
@@ -306,6 +326,14 @@ Invariants Model::invariants(const State& s) const {
     inv.L += L[e];
     inv.J += J[e];
   }
+  if (mb_)  // bodies (multibody.md (3.4)): ½m|φ̇|² + ½ΣE_i|ḋ_i|², L = mφ̇, J = φ × mφ̇ + Σ E_i d_i × ḋ_i
+    for (int b = 0; b < mb_->num_bodies(); ++b) {
+      const multibody::Vec12 q = mb_->body_q(b, s.u);
+      const multibody::Vec12 qd = s.v.segment<12>(mb_->body_first_dof(b));
+      inv.kinetic += mb_->body(b).kinetic_energy(qd);
+      inv.L += mb_->body(b).linear_momentum(qd);
+      inv.J += mb_->body(b).angular_momentum(q, qd);
+    }
   inv.strain = internal(s.u, s.charts, nullptr, nullptr);
   return inv;
 }
@@ -315,6 +343,11 @@ double Model::loads_end() const {
   for (const auto& load : loads_) end = std::max(end, load.function.end_of_support());
   for (const auto& load : follower_) end = std::max(end, load.function.end_of_support());
   for (const auto& m : prescribed_) end = std::max(end, m.function.end_of_variation());
+  if (mb_) {
+    if (mb_->num_bodies() > 0 && mb_->gravity().norm() > 0.0) end = std::numeric_limits<double>::infinity();
+    for (const auto& j : mb_->joints())
+      if (j.type == JointDef::Type::prescribed_rotation) end = std::max(end, j.angle.end_of_variation());
+  }
   return end;
 }
 
@@ -415,11 +448,12 @@ bool Model::kept_matrix_basis(const Eigen::VectorXd& u_ref, const std::vector<Di
                               const Eigen::VectorXd& u, const std::vector<DirectorChart>& charts, bool rotate,
                               std::vector<double>& node_inverse) const {
   const int nn = mesh_.num_nodes();
+  // Body unknowns (after the shell's) are ℝ³ vectors in space: T = I for them (no block).
   if (u_ref.size() != num_dofs() || u.size() != num_dofs() || static_cast<int>(charts_ref.size()) != nn ||
       static_cast<int>(charts.size()) != nn)
     throw std::invalid_argument("Model::kept_matrix_basis: u and charts do not match the model");
   // A rotation would mix constrained and free unknowns: only for unconstrained bodies (docs/theory.md §6.9).
-  if (rotate && (!dofs_.constrained_dofs().empty() || has_prescribed_motion())) rotate = false;
+  if (rotate && (!dofs_.constrained_dofs().empty() || has_prescribed_motion() || mb_)) rotate = false;
   Eigen::Matrix3d R = Eigen::Matrix3d::Identity();
   if (rotate) {  // least-squares rotation about the centroids (Kabsch): x − c ≈ R (x_ref − c_ref)
     Vec3 c_ref = Vec3::Zero(), c = Vec3::Zero();
@@ -484,6 +518,79 @@ bool Model::kept_matrix_basis(const Eigen::VectorXd& u_ref, const std::vector<Di
       for (int b = 0; b < 2; ++b) B[5 * (3 + a) + 3 + b] = Tq_inv(a, b);
   }
   return true;
+}
+
+// ---- Rigid bodies and joints (lib/model/model_multibody.hpp) ----------------------------------------------
+
+void Model::set_multibody(std::vector<RigidBodyDef> bodies, std::vector<JointDef> joints, const Vec3& gravity) {
+  if (bodies.empty() && joints.empty()) return;  // nothing changes (the pattern stays the element pattern)
+  if (has_damping()) throw std::logic_error("Model::set_multibody: call before set_rayleigh_damping");
+  auto mb = std::make_unique<ModelMultibody>(mesh_.X, normals_, std::move(bodies), std::move(joints), gravity);
+  dofs_.set_extra_dofs(12 * static_cast<Index>(mb->num_bodies()));
+  assembler_ = Assembler(mesh_.elements, mesh_.num_nodes(), dofs_.num_extra(), mb->couplings());
+  mb_ = std::move(mb);
+  const State s0 = initial_state();
+  dofs_.resolve(s0.charts);
+  step_cache_->valid = false;
+}
+
+ExactEnergySystem::RigidBlock Model::rigid_block(int b) const {
+  if (!mb_ || b < 0 || b >= mb_->num_bodies()) throw std::out_of_range("Model::rigid_block: no body " + std::to_string(b));
+  return {mb_->body_first_dof(b), mb_->body(b).mass(), mb_->body(b).euler_tensor()};
+}
+
+void Model::constraint_values(double t, const Eigen::VectorXd& u, const std::vector<DirectorChart>& charts,
+                              Eigen::VectorXd& g) const {
+  if (!mb_) return SemiDiscreteSystem::constraint_values(t, u, charts, g);
+  mb_->values(t, u, charts, g);
+}
+
+void Model::constraint_jacobian(double t, const Eigen::VectorXd& u, const std::vector<DirectorChart>& charts,
+                                ConstraintMatrix& G) const {
+  if (!mb_) return SemiDiscreteSystem::constraint_jacobian(t, u, charts, G);
+  mb_->jacobian(t, u, charts, dofs_, G);
+}
+
+void Model::constraint_time_derivative(double t, const Eigen::VectorXd& u, const std::vector<DirectorChart>& charts,
+                                       Eigen::VectorXd& g_t) const {
+  if (!mb_) return SemiDiscreteSystem::constraint_time_derivative(t, u, charts, g_t);
+  mb_->time_derivative(t, u, charts, g_t);
+}
+
+void Model::constraint_discrete_gradient(double t0, const Eigen::VectorXd& u0, double t1, const Eigen::VectorXd& u1,
+                                         const std::vector<DirectorChart>& charts, ConstraintMatrix& G_bar,
+                                         Eigen::VectorXd& tau) const {
+  if (!mb_) return SemiDiscreteSystem::constraint_discrete_gradient(t0, u0, t1, u1, charts, G_bar, tau);
+  mb_->discrete_gradient(t0, u0, t1, u1, charts, dofs_, G_bar, tau);
+}
+
+namespace {
+void add_triplets(const Assembler& a, const std::vector<Eigen::Triplet<double, Index>>& trip, SparseMatrix& K) {
+  for (const auto& t : trip) {
+    const Index pos = a.find(t.row(), t.col());
+    if (pos < 0)
+      throw std::logic_error("Model: constraint tangent entry (" + std::to_string(t.row()) + ", " + std::to_string(t.col()) +
+                             ") outside the pattern");
+    K.values[static_cast<size_t>(pos)] += t.value();
+  }
+}
+}  // namespace
+
+void Model::add_constraint_hessian(double t, const Eigen::VectorXd& u, const std::vector<DirectorChart>& charts,
+                                   const Eigen::VectorXd& lambda, double c, SparseMatrix& K) const {
+  if (!mb_ || mb_->num_constraints() == 0) return;
+  std::vector<Eigen::Triplet<double, Index>> trip;
+  mb_->hessian(t, u, charts, lambda, c, dofs_, trip);
+  add_triplets(assembler_, trip, K);
+}
+
+void Model::add_constraint_discrete_tangent(double t0, const Eigen::VectorXd& u0, double t1, const Eigen::VectorXd& u1,
+                                            const std::vector<DirectorChart>& charts, const Eigen::VectorXd& lambda,
+                                            double c, SparseMatrix& K) const {
+  if (!mb_ || mb_->num_constraints() == 0) return;
+  std::vector<Eigen::Triplet<double, Index>> trip;
+  mb_->discrete_tangent(t0, u0, t1, u1, charts, lambda, c, dofs_, trip);
+  add_triplets(assembler_, trip, K);
 }
 
 // ---- em-exact (docs/theory/exact-energy-momentum.md) ------------------------------------------------------

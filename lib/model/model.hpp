@@ -15,6 +15,7 @@
 #include "lib/model/assembler.hpp"
 #include "lib/model/dof_map.hpp"
 #include "lib/model/exact_energy_system.hpp"
+#include "lib/model/model_multibody.hpp"
 #include "lib/mesh/mesh.hpp"
 #include "lib/model/semi_discrete_system.hpp"
 #include "lib/linalg/sparse_matrix.hpp"
@@ -113,6 +114,36 @@ class Model final : public ExactEnergySystem {
   void damping_force(const Eigen::VectorXd& v, double* out) const override;
   void add_damping_matrix(double c, SparseMatrix& J) const override;
 
+  // ---- Rigid bodies and joints (lib/model/model_multibody.hpp; docs/theory/multibody.md §7) ----------------
+  // Adds the bodies' 12 unknowns each after the shell's and the joints' constraints; rebuilds the pattern
+  // (body blocks, constraint couplings). Call before anything that holds a matrix of the model (damping).
+  // Throws std::invalid_argument (one line naming the body or joint) on bad definitions.
+  void set_multibody(std::vector<RigidBodyDef> bodies, std::vector<JointDef> joints, const Vec3& gravity);
+  // Setup checks at the initial state s (ModelMultibody::check_initial): the joints are not redundant, do not act
+  // on supported DOFs, and hold at s (positions and velocities). No-op without joints.
+  void check_constraints(const State& s) const {
+    if (mb_) mb_->check_initial(s.u, s.v, s.charts, dofs_);
+  }
+  const ModelMultibody* multibody() const { return mb_.get(); }
+  int num_rigid_bodies() const override { return mb_ ? mb_->num_bodies() : 0; }
+  RigidBlock rigid_block(int b) const override;
+  Index num_constraints() const override { return mb_ ? mb_->num_constraints() : 0; }
+  std::vector<ConstraintBlock> constraint_blocks() const override { return mb_ ? mb_->blocks() : std::vector<ConstraintBlock>{}; }
+  void constraint_values(double t, const Eigen::VectorXd& u, const std::vector<DirectorChart>& charts,
+                         Eigen::VectorXd& g) const override;
+  void constraint_jacobian(double t, const Eigen::VectorXd& u, const std::vector<DirectorChart>& charts,
+                           ConstraintMatrix& G) const override;
+  void constraint_time_derivative(double t, const Eigen::VectorXd& u, const std::vector<DirectorChart>& charts,
+                                  Eigen::VectorXd& g_t) const override;
+  void constraint_discrete_gradient(double t0, const Eigen::VectorXd& u0, double t1, const Eigen::VectorXd& u1,
+                                    const std::vector<DirectorChart>& charts, ConstraintMatrix& G_bar,
+                                    Eigen::VectorXd& tau) const override;
+  void add_constraint_hessian(double t, const Eigen::VectorXd& u, const std::vector<DirectorChart>& charts,
+                              const Eigen::VectorXd& lambda, double c, SparseMatrix& K) const override;
+  void add_constraint_discrete_tangent(double t0, const Eigen::VectorXd& u0, double t1, const Eigen::VectorXd& u1,
+                                       const std::vector<DirectorChart>& charts, const Eigen::VectorXd& lambda,
+                                       double c, SparseMatrix& K) const override;
+
   // ---- ExactEnergySystem: the embedded kinematics of em-exact (lib/model/exact_energy_system.hpp) ----
   int num_nodes() const override { return mesh_.num_nodes(); }
   int num_elements() const override { return mesh_.num_elements(); }
@@ -176,6 +207,7 @@ class Model final : public ExactEnergySystem {
     std::vector<CR9Shell::StepState> states;
     bool valid = false;
   };
+  std::unique_ptr<ModelMultibody> mb_;  // null: no bodies, no joints
   std::unique_ptr<StepCache> step_cache_ = std::make_unique<StepCache>();
   const std::vector<CR9Shell::StepState>& step_states(const Eigen::VectorXd& u_n,
                                                       const std::vector<DirectorChart>& charts) const;

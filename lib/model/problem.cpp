@@ -79,16 +79,95 @@ State Problem::initial_state() const {
     for (int i = 0; i < model->mesh().num_nodes(); ++i) {
       const size_t si = static_cast<size_t>(i);
       const Eigen::Index k = static_cast<Eigen::Index>(DofMap::dof(i, 0));
-      if (disc.initial_velocity.size() == s.v.size()) s.v.segment<3>(k) = disc.initial_velocity.segment<3>(k);
+      if (disc.initial_velocity.size() >= k + 3) s.v.segment<3>(k) = disc.initial_velocity.segment<3>(k);
       const Vec3 p = model->director(s, i);
       const Vec3 w = si < disc.initial_director_rate.size() ? disc.initial_director_rate[si] : Vec3::Zero();
       s.v.segment<2>(k + 3) = chart_coordinates(w - w.dot(p) * p, s.charts[si]);
     }
     return with_prescribed_start(*model, std::move(s));
   }
-  if (disc.initial_velocity.size() == s.v.size()) s.v = disc.initial_velocity;
+  // The shell's initial velocity (5 per node); bodies keep theirs from Model::initial_state().
+  if (disc.initial_velocity.size() == 5 * static_cast<Index>(model->mesh().num_nodes()))
+    s.v.head(disc.initial_velocity.size()) = disc.initial_velocity;
   return with_prescribed_start(*model, std::move(s));
 }
+
+namespace {
+
+// rigid_bodies and joints of the case (docs/manual.md "Rigid bodies and joints") → the Model's definitions.
+void add_multibody(Model& model, const CaseSpec& spec, const Discretization& d) {
+  if (spec.rigid_bodies.empty() && spec.joints.empty()) return;
+  std::vector<RigidBodyDef> bodies;
+  for (const auto& b : spec.rigid_bodies)
+    bodies.push_back({b.name, b.mass, b.inertia, b.position, b.axes, b.velocity, b.angular_velocity});
+  auto body_index = [&](const std::string& name) {
+    for (size_t k = 0; k < spec.rigid_bodies.size(); ++k)
+      if (spec.rigid_bodies[k].name == name) return static_cast<int>(k);
+    return -1;  // the parser has checked the names
+  };
+  auto nodes_of = [&](const std::string& set, const std::string& where) -> const std::vector<int>& {
+    const auto it = d.mesh.node_sets.find(set);
+    if (it == d.mesh.node_sets.end()) {
+      std::string names;
+      for (const auto& [k, v] : d.mesh.node_sets) names += (names.empty() ? "" : ", ") + k;
+      throw std::runtime_error(where + ": unknown set '" + set + "' (define it under 'sets:'; available: " + names + ")");
+    }
+    if (it->second.empty()) throw std::runtime_error(where + ": set '" + set + "' has no nodes");
+    return it->second;
+  };
+  auto end = [&](const JointEndSpec& e, const std::string& joint) {
+    JointEnd out;
+    switch (e.kind) {
+      case JointEndSpec::Kind::set: {
+        const std::vector<int>& nodes = nodes_of(e.set, e.where);
+        if (nodes.size() != 1)
+          throw std::runtime_error(e.where + ": joint '" + joint + "': set '" + e.set + "' has " + std::to_string(nodes.size()) +
+                                   " nodes, a joint end needs exactly one (use a {point: [x,y,z]} set)");
+        out.kind = JointEnd::Kind::node;
+        out.node = nodes[0];
+        break;
+      }
+      case JointEndSpec::Kind::body:
+        out.kind = JointEnd::Kind::body;
+        out.body = body_index(e.body);
+        out.at = e.at;
+        break;
+      case JointEndSpec::Kind::ground:
+        out.kind = JointEnd::Kind::ground;
+        out.at = e.at;
+        break;
+      case JointEndSpec::Kind::none: break;
+    }
+    return out;
+  };
+  std::vector<JointDef> joints;
+  for (const auto& j : spec.joints) {
+    JointDef def;
+    def.name = j.name;
+    def.a = end(j.a, j.name);
+    def.b = end(j.b, j.name);
+    def.axis = j.axis;
+    def.point = j.point;
+    def.angle = j.angle;
+    def.angle_scale = j.amplitude;
+    if (j.type == "fixed_point") def.type = JointDef::Type::fixed_point;
+    else if (j.type == "spherical") def.type = JointDef::Type::spherical;
+    else if (j.type == "revolute") def.type = JointDef::Type::revolute;
+    else if (j.type == "rigid_connection") {
+      def.type = JointDef::Type::rigid_connection;
+      def.nodes = nodes_of(j.set, j.where + ".set");
+    } else def.type = JointDef::Type::prescribed_rotation;
+    if (!j.body.empty()) def.body = body_index(j.body);
+    joints.push_back(std::move(def));
+  }
+  try {
+    model.set_multibody(std::move(bodies), std::move(joints), spec.gravity);
+  } catch (const std::invalid_argument& e) {
+    throw std::runtime_error(spec.source + ": " + e.what());
+  }
+}
+
+}  // namespace
 
 Problem make_problem(CaseSpec spec) {
   Problem p;
@@ -96,11 +175,23 @@ Problem make_problem(CaseSpec spec) {
   p.disc = build_discretization(p.spec);
   try {
     p.model = std::make_unique<Model>(make_model(p.disc, p.spec.material));
+  } catch (const std::exception& e) {
+    throw std::runtime_error(p.spec.source + ": " + e.what());
+  }
+  add_multibody(*p.model, p.spec, p.disc);  // errors carry the joint's FILE:LINE
+  try {
     p.model->set_rayleigh_damping(p.spec.damping.mass, p.spec.damping.stiffness);
   } catch (const std::exception& e) {
     throw std::runtime_error(p.spec.source + ": " + e.what());
   }
   if (!p.spec.initial_displacement.empty()) (void)p.initial_state();  // a bad VTU is a case error, found now
+  if (p.model->num_constraints() > 0) {  // redundant joints, joints on supports, initial violation
+    try {
+      p.model->check_constraints(p.initial_state());
+    } catch (const std::invalid_argument& e) {
+      throw std::runtime_error(p.spec.source + ": joints: " + e.what());
+    }
+  }
   return p;
 }
 
