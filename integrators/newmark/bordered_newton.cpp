@@ -26,6 +26,8 @@ BorderedNewton::Result BorderedNewton::solve(const DofMap& dofs, const Eigen::Ve
   Eigen::VectorXd r(n), rho(n), g(m), y(n), b(n), du(n);
   ConstraintMatrix Gh, G;
   Eigen::MatrixXd Z(n, m);
+  const double u_max = std::max(1.0, u_n.cwiseAbs().maxCoeff());
+  double kbar_row_sum = 0.0;  // max_i Σ_j |K̄_ij| of the last K̄ (the residual's round-off level)
   bool fresh = false;        // K̄ factorized at the current iterate
   bool need_refresh = true;  // first iteration: form K̄
   double prev_norm = 0.0, last_step = std::numeric_limits<double>::infinity(), best = std::numeric_limits<double>::infinity();
@@ -49,8 +51,9 @@ BorderedNewton::Result BorderedNewton::solve(const DofMap& dofs, const Eigen::Ve
       res.converged = true;
       return res;
     }
-    // Round-off floor of the residual: it stopped falling with a K̄ formed at the previous iterate.
-    if (g_ok && k >= 2 && res.residual <= 1e-8 && res.residual > 0.5 * best) {
+    // Round-off floor of the residual (options): it stopped falling with a K̄ formed at the previous iterate.
+    const double level = kbar_row_sum * std::numeric_limits<double>::epsilon() * u_max / std::max(scale, 1e-300);
+    if (g_ok && k >= 2 && res.residual <= std::max(opt_.stall_tol, level) && res.residual > 0.5 * best) {
       if (fresh) {
         res.converged = true;
         return res;
@@ -70,6 +73,13 @@ BorderedNewton::Result BorderedNewton::solve(const DofMap& dofs, const Eigen::Ve
       cb.jacobian(u, J_);
       if (m > 0) cb.force_tangent(u, lambda, J_);
       apply_dirichlet(dofs, J_, nullptr);
+      kbar_row_sum = 0.0;  // full symmetric storage: column sums are the row sums
+      for (Index c = 0; c < J_.pattern->n; ++c) {
+        double sum = 0.0;
+        for (Index q = J_.pattern->colptr[static_cast<size_t>(c)]; q < J_.pattern->colptr[static_cast<size_t>(c) + 1]; ++q)
+          sum += std::abs(J_.values[static_cast<size_t>(q)]);
+        kbar_row_sum = std::max(kbar_row_sum, sum);
+      }
       try {
         solver_->factorize(J_.view());
       } catch (const std::exception& e) {

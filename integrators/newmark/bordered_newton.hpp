@@ -41,6 +41,10 @@ struct BorderedNewtonOptions {
   double g_tol = 1e-12;     // ‖g‖∞ (absolute; the constraints' own units: lengths and direction cosines)
   double step_tol = 1e-14;  // max_i |δu_i| / max(1, |u_n,i|): round-off reached
   double refresh = 0.1;     // refresh K̄ when ‖δu_k‖/‖δu_{k−1}‖ exceeds this (0: every iteration)
+  // Round-off floor (as em-exact's stall rule, docs/theory/newton-iteration.md §3): with ‖g‖∞ ≤ g_tol, an iterate
+  // whose scaled residual is below max(stall_tol, ε max_i Σ_j |K̄_ij| max(1, ‖u_n‖∞) / scale) and did not fall
+  // below half the best one before is accepted once K̄ is fresh.
+  double stall_tol = 1e-8;
 };
 
 class BorderedNewton {

@@ -146,7 +146,7 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
 
   std::string name() const override { return "em-exact"; }
   // Joints and rigid bodies (docs/theory/multibody.md §9.4; step_constrained()).
-  bool supports_constraints() const { return true; }
+  bool supports_constraints() const override { return true; }
   std::vector<std::pair<std::string, std::string>> settings() const override { return resolved_; }
   double external_work() const override { return work_; }
   double prescribed_work() const override { return prescribed_work_; }
@@ -714,6 +714,7 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
       o.linear_solver = nopt_.linear_solver;
       o.max_iters = nopt_.max_iters;
       o.res_tol = res_tol_;
+      o.stall_tol = stall_tol_;
       o.refresh = (nopt_.modified && !full_newton) ? 0.1 : 0.0;
       bn = std::make_unique<BorderedNewton>(sys.pattern(), o);
     }

@@ -150,7 +150,7 @@ class NewmarkFamily final : public Integrator {
   double prescribed_work() const override { return prescribed_work_; }
   bool supports_prescribed_motion() const override { return true; }
   // Holonomic constraints with index-3 multipliers (docs/theory/multibody.md §9; step_constrained()).
-  bool supports_constraints() const { return true; }
+  bool supports_constraints() const override { return true; }
   bool set_residual_trace(ResidualTrace trace) override {
     residual_trace_ = std::move(trace);
     return true;

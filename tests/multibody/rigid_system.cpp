@@ -3,11 +3,12 @@
 
 namespace shelldyn::multibody::testing {
 
-// DofMap counts 5 unknowns per "node"; enough of them to cover the 12 per body (none constrained).
+// No shell nodes: the bodies' unknowns are the DofMap's extra (free) unknowns.
 RigidSystem::RigidSystem(std::vector<RigidBody> bodies, Eigen::VectorXd q0, Eigen::VectorXd v0, Vec3 gravity)
     : bodies_(std::move(bodies)), q0_(std::move(q0)), v0_(std::move(v0)), gravity_(gravity),
-      n_(12 * static_cast<Index>(bodies_.size())), dofs_(static_cast<int>((n_ + 4) / 5)), set_(static_cast<int>(n_)) {
-  dofs_.resolve(std::vector<DirectorChart>(static_cast<size_t>((n_ + 4) / 5)));
+      n_(12 * static_cast<Index>(bodies_.size())), dofs_(0), set_(static_cast<int>(n_)) {
+  dofs_.set_extra_dofs(n_);
+  dofs_.resolve({});
   auto p = std::make_shared<SparsePattern>();  // dense: joints couple any two bodies
   p->n = n_;
   for (Index c = 0; c <= n_; ++c) p->colptr.push_back(c * n_);
