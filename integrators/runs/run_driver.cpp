@@ -312,9 +312,9 @@ RunSummary run_dynamic(Problem& problem, const RunOptions& o) {
   if (model.num_constraints() > 0 && !integrator->supports_constraints()) {
     std::string able;
     for (const auto& n : integrators_supporting_constraints()) able += (able.empty() ? "" : ", ") + n;
-    throw std::invalid_argument("integrator '" + integrator->name() + "' does not enforce joints, and the case has " +
-                                std::to_string(model.num_constraints()) + " constraint rows (joints, rigid-body frames); use " +
-                                (able.empty() ? std::string("an integrator that does (none is registered)") : "one of: " + able));
+    throw std::invalid_argument("integrator '" + integrator->name() + "' does not enforce joints (" +
+                                std::to_string(model.num_constraints()) + " constraint rows); use " +
+                                (able.empty() ? std::string("one that does (none registered)") : "one of: " + able));
   }
 
   RunSummary sum;

@@ -418,8 +418,20 @@ void ModelMultibody::check_initial(const Eigen::VectorXd& u0, const Eigen::Vecto
       if (off >= b.first_row && off < b.first_row + b.rows) owner[set_[i].name()] = {b.name, b.type};
   }
   // 1. Redundant or conflicting joints among themselves (multibody.md §2.5).
+  // A short form of RankReport::message with the user's joint names (one line).
+  auto rank_message = [&](const multibody::RankReport& r, const std::string& extra) {
+    std::string names;
+    std::set<std::string> seen;
+    for (const std::string& cname : r.involved) {
+      const auto it = owner.find(cname);
+      const std::string text = it == owner.end() ? cname : it->second.second + " '" + it->second.first + "'";
+      if (seen.insert(text).second) names += (names.empty() ? "" : ", ") + text;
+    }
+    return std::string(r.conflicting ? "conflicting" : "redundant") + " joints: " + std::to_string(r.rows - r.rank) + " of " +
+           std::to_string(r.rows) + " rows dependent at t = 0" + extra + ", involving " + names + "; remove one";
+  };
   const multibody::RankReport free_rep = set_.rank_check(y, 0.0);
-  if (!free_rep.message.empty()) throw std::invalid_argument(free_rep.message);
+  if (!free_rep.message.empty()) throw std::invalid_argument(rank_message(free_rep, ""));
   // 2. Joints on DOFs that boundary conditions fix: the same check with those columns dropped.
   const Index body_y0 = 6 * static_cast<Index>(slot_nodes_.size());
   std::vector<bool> fixed(static_cast<size_t>(ny_), false);
@@ -452,9 +464,8 @@ void ModelMultibody::check_initial(const Eigen::VectorXd& u0, const Eigen::Vecto
       what += (what.empty() ? "" : "; ") + std::string("joint '") + user + "' acts on " + dofs_text;
     }
     if (!what.empty())
-      throw std::invalid_argument(what + ", which boundary_conditions already fix: remove the joint or free those DOFs (" +
-                                  rep.message + ")");
-    throw std::invalid_argument(rep.message);
+      throw std::invalid_argument(what + ", which boundary_conditions fix: remove the joint or free those DOFs");
+    throw std::invalid_argument(rank_message(rep, " with the supports"));
   }
   // 3. The initial state satisfies the joints (positions, then velocities).
   double scale = 1.0;
@@ -465,8 +476,7 @@ void ModelMultibody::check_initial(const Eigen::VectorXd& u0, const Eigen::Vecto
     const double e = g.segment(b.first_row, b.rows).cwiseAbs().maxCoeff();
     if (e > tol * scale)
       throw std::invalid_argument(b.type + " '" + b.name + "' is violated by " + num(e) +
-                                  " at t = 0 (max |g|): place its ends at the same point in the initial configuration "
-                                  "(`at`, the body's position and axes)");
+                                  " at t = 0: put its ends together (`at`, body position, axes)");
   }
   ConstraintMatrix G;
   jacobian(0.0, u0, charts, dofs, G);
@@ -478,9 +488,8 @@ void ModelMultibody::check_initial(const Eigen::VectorXd& u0, const Eigen::Vecto
   for (const auto& b : blocks_) {
     const double e = gdot.segment(b.first_row, b.rows).cwiseAbs().maxCoeff();
     if (e > tol * scale * vscale)
-      throw std::invalid_argument(b.type + " '" + b.name + "': the initial velocities violate it by " + num(e) +
-                                  " (max |G v + ∂g/∂t| at t = 0): give the bodies' velocity/angular_velocity and the "
-                                  "shell's initial_velocity consistent with the joint");
+      throw std::invalid_argument(b.type + " '" + b.name + "': initial velocities violate it by " + num(e) +
+                                  " (|G v + dg/dt|): make them consistent with the joint");
   }
 }
 

@@ -110,7 +110,7 @@ void add_multibody(Model& model, const CaseSpec& spec, const Discretization& d) 
     if (it == d.mesh.node_sets.end()) {
       std::string names;
       for (const auto& [k, v] : d.mesh.node_sets) names += (names.empty() ? "" : ", ") + k;
-      throw std::runtime_error(where + ": unknown set '" + set + "' (define it under 'sets:'; available: " + names + ")");
+      throw std::runtime_error(where + ": unknown set '" + set + "' (define it under 'sets:' or use one below)\navailable: " + names);
     }
     if (it->second.empty()) throw std::runtime_error(where + ": set '" + set + "' has no nodes");
     return it->second;
@@ -122,7 +122,7 @@ void add_multibody(Model& model, const CaseSpec& spec, const Discretization& d) 
         const std::vector<int>& nodes = nodes_of(e.set, e.where);
         if (nodes.size() != 1)
           throw std::runtime_error(e.where + ": joint '" + joint + "': set '" + e.set + "' has " + std::to_string(nodes.size()) +
-                                   " nodes, a joint end needs exactly one (use a {point: [x,y,z]} set)");
+                                   " nodes, a joint end needs one (a {point} set)");
         out.kind = JointEnd::Kind::node;
         out.node = nodes[0];
         break;
