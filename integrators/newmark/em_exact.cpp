@@ -3,6 +3,7 @@
 #include "integrators/newmark/em_exact.hpp"
 
 #include "elements/exact_energy.hpp"
+#include "integrators/newmark/bordered_newton.hpp"
 #include "integrators/newmark/consistent_acceleration.hpp"
 #include "integrators/newmark/kept_iteration_matrix.hpp"
 #include "integrators/nonlinear/energy_floor_test.hpp"
@@ -144,6 +145,8 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
   }
 
   std::string name() const override { return "em-exact"; }
+  // Joints and rigid bodies (docs/theory/multibody.md §9.4; step_constrained()).
+  bool supports_constraints() const override { return true; }
   std::vector<std::pair<std::string, std::string>> settings() const override { return resolved_; }
   double external_work() const override { return work_; }
   double prescribed_work() const override { return prescribed_work_; }
@@ -167,6 +170,7 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
     c.scalars["W_ext"] = work_;
     c.scalars["W_presc"] = prescribed_work_;
     c.scalars["steps"] = static_cast<double>(steps_);
+    if (lambda_.size() > 0) c.vectors["lambda"] = lambda_;  // constrained steps: the next step's guess
     c.scalars["diag_dissipation"] = diag_.dissipation;
     c.scalars["diag_min_step_dissipation"] = diag_.min_step_dissipation;
     c.scalars["diag_max_residual"] = diag_.max_residual;
@@ -229,6 +233,7 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
       start_newmark_recursion(s);
     }
     kept_.restore(c, *newton_, nopt_.modified, sys, "em-exact");
+    if (c.vectors.count("lambda")) lambda_ = c.vector("lambda", sys.num_constraints());
     // certify = auto with modified Newton: a resumed run keeps the rule it started with (theory §5.8). A
     // checkpoint without the record was written when auto meant floor (before the fifteenth session). A run begun
     // with certify = energy (theory §5.10) continues with it too. These rules all skip the accepted iterate's
@@ -274,6 +279,12 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
       }
     }
     if (s.a.size() != n) s.a.setZero(n);
+    if (sys.num_constraints() > 0 && sys.has_prescribed_motion())
+      throw std::invalid_argument("em-exact: joints together with prescribed displacement histories are not supported "
+                                  "(drive the motion through a prescribed_rotation joint instead)");
+    lambda_.setZero(sys.num_constraints());
+    bordered_.reset();
+    bordered_full_.reset();
     {  // K + V at the start, with the embedded w just set: the scale of certify = energy's floor (theory §5.10)
       const Invariants inv = sys.invariants(s);
       energy0_ = std::abs(inv.kinetic) + std::abs(inv.strain);
@@ -392,6 +403,7 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
   }
 
   bool step(State& s, double h, StepReport& rep, std::string* why, bool full_newton = false) {
+    if (model_->num_constraints() > 0 || model_->num_rigid_bodies() > 0) return step_constrained(s, h, rep, why, full_newton);
     ExactEnergySystem& sys = *model_;
     rep.chart_switches += sys.rechart(s, hysteresis_);  // between steps only; d, p, v, w unchanged
     kept_.start_step(h, *newton_);  // K̄ depends on h
@@ -682,6 +694,152 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
     rep.last_dt = h;
     return true;
   }
+
+  // ---- Constrained step: joints and rigid bodies (docs/theory/multibody.md §9.4) -------------------------------
+  // step()'s balance with the constraint force Ḡᵀλ, Ḡ = Ḡ(u_n, u_{n+1}) the system's discrete gradient (Ḡ Δu + τ =
+  // Δg exactly), and g(u_{n+1}, t_{n+1}) = 0. The rigid bodies' blocks (ExactEnergySystem::rigid_block, constant
+  // mass M_b) take the midpoint rule with embedded velocities like the shell translations:
+  //     M_b (v_{n+1} − v_n)/Δt + F_b − F_ext,b(t_mid) = 0,      v_{n+1} = 2Δq_b/Δt − v_n,
+  // so that their K is conserved exactly (constant M_b) and their momenta (3.4) too. The energy identity of step()
+  // gains −λ·ḠΔu = −λ·(Δg − τ) = λ·τ (g_n = g_{n+1} = 0): ΔK + ΔV = W_ext + λ·τ, λ·τ (a driver's work) counted in
+  // W_presc. The iteration is BorderedNewton's (bordered_newton.hpp; K̄ = (2/Δt²)M + ½K + ∂(Ḡᵀλ)/∂u_{n+1}), which
+  // stops at ‖r + Ḡᵀλ‖∞/scale ≤ res_tol and ‖g‖∞ ≤ 1e-12, or at the residual's round-off floor; the stall, floor and
+  // predicted rules of step() are not used here.
+  bool step_constrained(State& s, double h, StepReport& rep, std::string* why, bool full_newton) {
+    ExactEnergySystem& sys = *model_;
+    rep.chart_switches += sys.rechart(s, hysteresis_);
+    std::unique_ptr<BorderedNewton>& bn = full_newton ? bordered_full_ : bordered_;
+    if (!bn) {
+      BorderedNewtonOptions o;
+      o.linear_solver = nopt_.linear_solver;
+      o.max_iters = nopt_.max_iters;
+      o.res_tol = res_tol_;
+      o.stall_tol = stall_tol_;
+      o.refresh = (nopt_.modified && !full_newton) ? 0.1 : 0.0;
+      bn = std::make_unique<BorderedNewton>(sys.pattern(), o);
+    }
+    const auto& charts = s.charts;
+    const Index n = sys.num_dofs(), m = sys.num_constraints();
+    const double tn = s.t, t1 = s.t + h, tmid = s.t + 0.5 * h;
+    un_ = s.u;
+    for (int i = 0; i < nn_; ++i) vn_.segment<3>(3 * i) = s.v.segment<3>(DofMap::dof(i, 0));
+    wn_ = s.pdot;
+    directors(un_, charts, pn_);
+    sys.step_energies(un_, charts, Un_);
+    const Eigen::VectorXd vrb_n = s.v;  // rigid blocks' velocities (their entries)
+    Eigen::VectorXd fext_rb(n), tau;
+    ExactEnergySystem::ExactForceInfo finfo;
+    const int nb = sys.num_rigid_bodies();
+    BorderedNewton::Callbacks cb;
+    cb.residual = [&](const Eigen::VectorXd& u, Eigen::VectorXd& r) {  // step()'s residual, plus the rigid blocks
+      kinematics(u, charts, h, tmid);
+      sys.exact_internal(un_, u, charts, Un_, correction_, xi_, xi_ > 0.0 ? &k0_ : nullptr, fint_.data(), nullptr, nullptr,
+                         &finfo, &pmid_);
+      r.setZero(n);
+      double scale = 0.0;
+      for (int i = 0; i < nn_; ++i) {
+        const Index k = DofMap::dof(i, 0);
+        const Vec3 Ad = mv_.segment<3>(3 * i), Ap = mw_.segment<3>(3 * i);
+        const Vec3 fd = fd_.segment<3>(3 * i), g = g_.segment<3>(3 * i);
+        r.segment<3>(k) = Ad + fint_.segment<3>(k) - fd;
+        const DirectorChart& ch = charts[static_cast<size_t>(i)];
+        r.segment<2>(k + 3) = embedded_A1(Vec3(pmid_.segment<3>(3 * i)), ch).transpose() * (Ap - g) + fint_.segment<2>(k + 3);
+        scale = std::max({scale, Ad.cwiseAbs().maxCoeff(), Ap.cwiseAbs().maxCoeff(), fd.cwiseAbs().maxCoeff(),
+                          g.cwiseAbs().maxCoeff(), fint_.segment<5>(k).cwiseAbs().maxCoeff()});
+      }
+      if (nb > 0) {
+        umid_ = 0.5 * (u + un_);
+        sys.external(tmid, umid_, charts, fext_rb.data());  // dead loads (gravity) on the bodies at t_mid
+      }
+      for (int b = 0; b < nb; ++b) {
+        const ExactEnergySystem::RigidBlock blk = sys.rigid_block(b);
+        const Index k = blk.first_dof;
+        Eigen::Matrix<double, 12, 1> md;
+        md << Eigen::Vector3d::Constant(blk.mass), Eigen::Vector3d::Constant(blk.E[0]), Eigen::Vector3d::Constant(blk.E[1]),
+            Eigen::Vector3d::Constant(blk.E[2]);
+        const Eigen::Matrix<double, 12, 1> dv = (2.0 / h) * (u.segment<12>(k) - un_.segment<12>(k)) - 2.0 * vrb_n.segment<12>(k);
+        const Eigen::Matrix<double, 12, 1> inertia = md.cwiseProduct(dv) / h;
+        r.segment<12>(k) = inertia + fint_.segment<12>(k) - fext_rb.segment<12>(k);
+        scale = std::max({scale, inertia.cwiseAbs().maxCoeff(), fint_.segment<12>(k).cwiseAbs().maxCoeff(),
+                          fext_rb.segment<12>(k).cwiseAbs().maxCoeff()});
+      }
+      zero_constrained(sys.dofs(), r.data());
+      last_u_ = u;
+      return std::max(scale, 1e-300);
+    };
+    cb.jacobian = [&](const Eigen::VectorXd& u, SparseMatrix& J) {  // step()'s K̄; the rigid blocks' is (2/Δt²) M_b
+      umid_ = 0.5 * (u + un_);
+      sys.mass(umid_, charts, M_);
+      sys.exact_internal(un_, u, charts, Un_, false, xi_, xi_ > 0.0 ? &k0_ : nullptr, nullptr, &K_, nullptr, nullptr);
+      sys.add_load_stiffness(tmid, umid_, charts, K_);
+      const double cm = 2.0 / (h * h);
+      for (size_t k = 0; k < J.values.size(); ++k) J.values[k] = cm * M_.values[k] + 0.5 * K_.values[k];
+    };
+    cb.force_matrix = [&](const Eigen::VectorXd& u, BorderedNewton::ConstraintMatrix& Gh) {
+      sys.constraint_discrete_gradient(tn, un_, t1, u, charts, Gh, tau);
+    };
+    cb.force_tangent = [&](const Eigen::VectorXd& u, const Eigen::VectorXd& l, SparseMatrix& J) {
+      sys.add_constraint_discrete_tangent(tn, un_, t1, u, charts, l, 1.0, J);
+    };
+    cb.constraints = [&](const Eigen::VectorXd& u, Eigen::VectorXd& g, BorderedNewton::ConstraintMatrix& G) {
+      sys.constraint_values(t1, u, charts, g);
+      sys.constraint_jacobian(t1, u, charts, G);
+    };
+    Eigen::VectorXd u = un_;  // predictor u_n (the trapezoidal one is step()'s)
+    Eigen::VectorXd lambda = lambda_;
+    const BorderedNewton::Result r = bn->solve(sys.dofs(), un_, u, lambda, m, cb);
+    rep.nonlinear_iterations += r.iterations;
+    rep.linear_setups += r.factorizations;
+    rep.factorizations += r.factorizations;
+    rep.rhs_evaluations += r.residual_evals;
+    rep.residual_norm = r.residual;
+    if (!r.converged) {
+      *why = r.message;
+      hint_ = "set max_cuts=4 (halve the step)";
+      return false;
+    }
+    lambda_ = lambda;
+    u = last_u_;  // the accepted iterate was the last evaluated one (kinematics() and fint_ are its)
+    diag_.max_residual = std::max(diag_.max_residual, r.residual);
+    diag_.max_beta_z = std::max(diag_.max_beta_z, finfo.max_beta_z);
+    diag_.rigid_guards += finfo.rigid_guards;
+    diag_.min_step_dissipation = std::min(diag_.min_step_dissipation, 0.0);
+    {  // the drivers' discrete work λ·τ (multibody.md (2.3))
+      BorderedNewton::ConstraintMatrix Gb;
+      sys.constraint_discrete_gradient(tn, un_, t1, u, charts, Gb, tau);
+      if (tau.size() == m) prescribed_work_ += lambda.dot(tau);
+    }
+    double dw = g_.dot(p1_ - pn_);  // external work as step() (theory §4), plus the bodies' loads
+    for (int i = 0; i < nn_; ++i) {
+      const Index k = DofMap::dof(i, 0);
+      dw += fd_.segment<3>(3 * i).dot(u.segment<3>(k) - un_.segment<3>(k));
+    }
+    for (int b = 0; b < nb; ++b) {
+      const Index k = sys.rigid_block(b).first_dof;
+      dw += fext_rb.segment<12>(k).dot(u.segment<12>(k) - un_.segment<12>(k));
+      s.v.segment<12>(k) = (2.0 / h) * (u.segment<12>(k) - un_.segment<12>(k)) - vrb_n.segment<12>(k);
+      s.a.segment<12>(k) = (s.v.segment<12>(k) - vrb_n.segment<12>(k)) / h;
+    }
+    work_ += dw;
+    wdot_ = (w1_ - wn_) / h;
+    for (int i = 0; i < nn_; ++i) {  // as step()
+      const Index k = DofMap::dof(i, 0);
+      const DirectorChart& ch = charts[static_cast<size_t>(i)];
+      s.v.segment<3>(k) = v1_.segment<3>(3 * i);
+      s.a.segment<3>(k) = (v1_.segment<3>(3 * i) - vn_.segment<3>(3 * i)) / h;
+      s.v.segment<2>(k + 3) = chart_coordinates(Vec3(w1_.segment<3>(3 * i)), ch);
+      s.a.segment<2>(k + 3) = chart_coordinates(Vec3(wdot_.segment<3>(3 * i)), ch);
+    }
+    s.pdot = w1_;
+    s.u = u;
+    s.t = t1;
+    ++steps_;
+    ++rep.steps;
+    rep.last_dt = h;
+    return true;
+  }
+  std::unique_ptr<BorderedNewton> bordered_, bordered_full_;  // constrained steps (full: the retry)
+  Eigen::VectorXd lambda_;                                    // the last step's multipliers (the next guess)
 
   double dt_;
   double xi_ = 0.0;

@@ -1,5 +1,6 @@
 #include "integrators/newmark/em_generalized_alpha.hpp"
 
+#include "integrators/newmark/bordered_newton.hpp"
 #include "integrators/newmark/consistent_acceleration.hpp"
 #include "integrators/newmark/kept_iteration_matrix.hpp"
 #include "integrators/nonlinear/energy_floor_test.hpp"
@@ -148,6 +149,8 @@ class NewmarkFamily final : public Integrator {
   double damping_work() const override { return damping_work_; }
   double prescribed_work() const override { return prescribed_work_; }
   bool supports_prescribed_motion() const override { return true; }
+  // Holonomic constraints with index-3 multipliers (docs/theory/multibody.md §9; step_constrained()).
+  bool supports_constraints() const override { return true; }
   bool set_residual_trace(ResidualTrace trace) override {
     residual_trace_ = std::move(trace);
     return true;
@@ -166,6 +169,7 @@ class NewmarkFamily final : public Integrator {
     c.scalars["W_presc"] = prescribed_work_;
     c.scalars["steps"] = static_cast<double>(steps_);
     c.scalars["energy0"] = energy0_;  // scale of the energy floor (initialize() would take the restored state's)
+    if (lambda_.size() > 0) c.vectors["lambda"] = lambda_;  // constrained steps: the next step's guess
     kept_.save(c, *newton_, nopt_.modified);
   }
 
@@ -178,6 +182,7 @@ class NewmarkFamily final : public Integrator {
     prescribed_work_ = c.scalars.count("W_presc") ? c.scalar("W_presc") : 0.0;
     steps_ = static_cast<long>(c.scalar("steps"));
     energy0_ = c.scalar("energy0");
+    if (c.vectors.count("lambda")) lambda_ = c.vector("lambda", sys.num_constraints());
     kept_.restore(c, *newton_, nopt_.modified, sys, name_);
   }
 
@@ -193,6 +198,14 @@ class NewmarkFamily final : public Integrator {
     {
       const Invariants inv = sys.invariants(s);
       energy0_ = std::abs(inv.kinetic) + std::abs(inv.strain);
+    }
+    if (sys.num_constraints() > 0) {  // multibody.md §9.3: M a + Gᵀλ = f, G a = −(d/dt)(G) u̇
+      if (sys.has_prescribed_motion())
+        throw std::invalid_argument(name_ + ": joints together with prescribed displacement histories are not supported "
+                                    "(drive the motion through a prescribed_rotation joint instead)");
+      constrained_acceleration(sys, s, nopt_.linear_solver, s.a, &lambda_);
+      bordered_.reset();
+      return;
     }
     consistent_acceleration(sys, s, nopt_.linear_solver, s.a);  // docs/theory.md §6.4 start-up
   }
@@ -234,6 +247,7 @@ class NewmarkFamily final : public Integrator {
 
   // One step of size h from s (docs/theory.md §6.6). Returns false (s unchanged but for charts) on failure.
   bool step(SemiDiscreteSystem& sys, State& s, double h, StepReport& rep, std::string* why, bool full_newton = false) {
+    if (sys.num_constraints() > 0) return step_constrained(sys, s, h, rep, why, full_newton);
     rep.chart_switches += sys.rechart(s, hysteresis_);  // §2.3: between steps only
     kept_.start_step(h, *newton_);  // K̄ depends on h (modified Newton)
     if (full_newton && !full_newton_) {
@@ -409,6 +423,161 @@ class NewmarkFamily final : public Integrator {
     rep.last_dt = h;
     return true;
   }
+
+  // ---- Constrained step (docs/theory/multibody.md §9.1) ---------------------------------------------------------
+  // The step of step() with the constraint force Ĝᵀλ in the residual and g(u_{n+1}, t_{n+1}) = 0 among the
+  // equations, λ a new unknown of each step (index 3):
+  //   em-galpha, midpoint:  Ĝ from the discrete gradient Ḡ(u_n, u_{n+1}) (multibody.md §2), so that at ρ∞ = 1, where
+  //                         the unconstrained step conserves energy, the constraint forces do no discrete work;
+  //   galpha, newmark:      Ĝ from the end-point Jacobians, as the classical index-3 schemes.
+  // λ is the reaction of the α_f-weighted balance (multibody.md §9.1 argues it against Arnold & Brüls' form). The
+  // iteration is BorderedNewton's (bordered_newton.hpp: K̄ kept, Schur complement on the constraint rows) instead of
+  // KINSOL's; full_newton (the retry of step_with_cuts) refreshes K̄ every iteration.
+  bool step_constrained(SemiDiscreteSystem& sys, State& s, double h, StepReport& rep, std::string* why, bool full_newton) {
+    rep.chart_switches += sys.rechart(s, hysteresis_);  // §2.3: between steps only
+    std::unique_ptr<BorderedNewton>& bn = full_newton ? bordered_full_ : bordered_;
+    if (!bn) {
+      BorderedNewtonOptions o;
+      o.linear_solver = nopt_.linear_solver;
+      o.max_iters = nopt_.max_iters;
+      o.refresh = (nopt_.modified && !full_newton) ? 0.1 : 0.0;
+      bn = std::make_unique<BorderedNewton>(sys.pattern(), o);
+    }
+    const double am = p_.alpha_m, af = p_.alpha_f, be = p_.beta, ga = p_.gamma;
+    const double tn = s.t, t1 = s.t + h, tmid = t1 - af * h;
+    un_ = s.u;
+    vn_ = s.v;
+    an_ = s.a;
+    const auto& charts = s.charts;
+    const Index n = sys.num_dofs(), m = sys.num_constraints();
+    const double cu = (1 - af) * ga / (be * h), cv = ((1 - af) * ga - be) / be, ca = (1 - af) * (ga - 2 * be) / (2 * be) * h;
+    const double du = (1 - am) / (be * h * h), dv = (1 - am) / (be * h), da = (1 - am - 2 * be) / (2 * be);
+    const bool endpoint = (scheme_ == Scheme::Galpha || scheme_ == Scheme::Newmark);
+    if (endpoint) {
+      sys.internal(un_, charts, fint_n_.data(), nullptr);
+      sys.external(tn, un_, charts, fext_n_.data());
+    }
+    auto midpoint_state = [&](const Eigen::VectorXd& uu) {
+      umid_ = (1 - af) * uu + af * un_;
+      vmid_ = cu * (uu - un_) - cv * vn_ - ca * an_;
+      amid_ = du * (uu - un_) - dv * vn_ - da * an_;
+    };
+    auto external_force = [&](const Eigen::VectorXd& uu) {
+      if (endpoint) {
+        sys.external(t1, uu, charts, tmp_.data());
+        fext_ = (1 - af) * tmp_ + af * fext_n_;
+      } else {
+        sys.external(tmid, umid_, charts, fext_.data());
+      }
+    };
+    BorderedNewton::Callbacks cb;
+    cb.residual = [&](const Eigen::VectorXd& uu, Eigen::VectorXd& r) {  // as step()'s residual
+      midpoint_state(uu);
+      sys.inertia_force(umid_, vmid_, amid_, charts, fm_.data());
+      switch (scheme_) {
+        case Scheme::EmGalpha: sys.algorithmic_internal(un_, uu, charts, af, xi_, fint_.data(), nullptr); break;
+        case Scheme::Midpoint: sys.internal(umid_, charts, fint_.data(), nullptr); break;
+        case Scheme::Galpha:
+        case Scheme::Newmark:
+          sys.internal(uu, charts, fint_.data(), nullptr);
+          fint_ = (1 - af) * fint_ + af * fint_n_;
+          break;
+      }
+      external_force(uu);
+      r = fm_ + fint_ - fext_;
+      zero_constrained(sys.dofs(), r.data());
+      return std::max({fm_.cwiseAbs().maxCoeff(), fint_.cwiseAbs().maxCoeff(), fext_.cwiseAbs().maxCoeff(), 1e-300});
+    };
+    cb.jacobian = [&](const Eigen::VectorXd& uu, SparseMatrix& J) {  // as step()'s K̄ (§6.4)
+      midpoint_state(uu);
+      sys.mass(umid_, charts, M_);
+      switch (scheme_) {
+        case Scheme::EmGalpha:
+          sys.algorithmic_internal(un_, uu, charts, af, xi_, nullptr, &K_);
+          sys.add_load_stiffness(tmid, umid_, charts, K_);
+          break;
+        case Scheme::Midpoint:
+          sys.internal(umid_, charts, nullptr, &K_);
+          sys.add_load_stiffness(tmid, umid_, charts, K_);
+          break;
+        case Scheme::Galpha:
+        case Scheme::Newmark:
+          sys.internal(uu, charts, nullptr, &K_);
+          sys.add_load_stiffness(t1, uu, charts, K_);
+          break;
+      }
+      for (size_t k = 0; k < J.values.size(); ++k) J.values[k] = du * M_.values[k] + (1 - af) * K_.values[k];
+      sys.add_damping_matrix(cu, J);
+    };
+    // Ĝ (multibody.md §9.1): the constraint force is weighted like the scheme's other forces, at t_{n+1−α_f}:
+    //   galpha, newmark:     Ĝ = (1−α_f) G(u_{n+1}) + α_f G(u_n)                       (index 3; newmark: G(u_{n+1}));
+    //   em-galpha, midpoint: Ĝ = Ḡ(u_n, u_{n+1}) + (½ − α_f)(G(u_{n+1}) − G(u_n)),
+    // which is the discrete gradient at ρ∞ = 1 (α_f = ½: no discrete work, conserving) and G(u_{n+1−α_f}) for every
+    // quadratic constraint. Ĝ = G(u_{n+1}) alone, or Ḡ alone at α_f ≠ ½, puts the reaction O(Δt) off the time of
+    // the balance and the scheme drops to first order (measured, multibody.md §9.5).
+    Eigen::VectorXd tau;
+    BorderedNewton::ConstraintMatrix G_n, G_1;
+    sys.constraint_jacobian(tn, un_, charts, G_n);
+    cb.force_matrix = [&](const Eigen::VectorXd& uu, BorderedNewton::ConstraintMatrix& Gh) {
+      sys.constraint_jacobian(t1, uu, charts, G_1);
+      if (endpoint) {
+        Gh = (1 - af) * G_1 + af * G_n;
+      } else {
+        sys.constraint_discrete_gradient(tn, un_, t1, uu, charts, Gh, tau);
+        if (af != 0.5) Gh += (0.5 - af) * (G_1 - G_n);
+      }
+    };
+    cb.force_tangent = [&](const Eigen::VectorXd& uu, const Eigen::VectorXd& l, SparseMatrix& J) {
+      if (endpoint) {
+        sys.add_constraint_hessian(t1, uu, charts, l, 1 - af, J);
+      } else {
+        sys.add_constraint_discrete_tangent(tn, un_, t1, uu, charts, l, 1.0, J);
+        if (af != 0.5) sys.add_constraint_hessian(t1, uu, charts, l, 0.5 - af, J);
+      }
+    };
+    cb.constraints = [&](const Eigen::VectorXd& uu, Eigen::VectorXd& g, BorderedNewton::ConstraintMatrix& G) {
+      sys.constraint_values(t1, uu, charts, g);
+      sys.constraint_jacobian(t1, uu, charts, G);
+    };
+    Eigen::VectorXd u = un_;
+    if (newmark_predictor_ && !full_newton) u += h * vn_ + (0.5 * h * h) * an_;
+    Eigen::VectorXd lambda = lambda_;
+    const BorderedNewton::Result r = bn->solve(sys.dofs(), un_, u, lambda, m, cb);
+    rep.nonlinear_iterations += r.iterations;
+    rep.linear_setups += r.factorizations;
+    rep.factorizations += r.factorizations;
+    rep.rhs_evaluations += r.residual_evals;
+    rep.residual_norm = r.residual;
+    if (!r.converged) {
+      *why = r.message;
+      return false;
+    }
+    lambda_ = lambda;
+    // The drivers' discrete work λ·τ (multibody.md §2.1, (2.3)), counted with the prescribed work: H = K + V − W_ext −
+    // W_presc. For galpha / newmark it is the same quadrature of the drivers' power, not an identity.
+    {
+      BorderedNewton::ConstraintMatrix Gb;
+      sys.constraint_discrete_gradient(tn, un_, t1, u, charts, Gb, tau);
+      if (tau.size() == m) prescribed_work_ += lambda.dot(tau);
+    }
+    midpoint_state(u);
+    external_force(u);
+    work_ += fext_.dot(u - un_);
+    if (sys.has_damping()) {
+      sys.damping_force(vmid_, tmp_.data());
+      damping_work_ += tmp_.dot(u - un_);
+    }
+    s.a = (u - un_) / (be * h * h) - vn_ / (be * h) - (0.5 / be - 1.0) * an_;  // §6.2 Newmark updates
+    s.v = vn_ + h * ((1 - ga) * an_ + ga * s.a);
+    s.u = u;
+    s.t = t1;
+    ++steps_;
+    ++rep.steps;
+    rep.last_dt = h;
+    return true;
+  }
+  std::unique_ptr<BorderedNewton> bordered_, bordered_full_;  // constrained steps (full: the retry)
+  Eigen::VectorXd lambda_;                                    // the last step's multipliers (the next guess)
 
   Scheme scheme_;
   std::string name_;
