@@ -62,11 +62,21 @@ CorotationalFrame::CorotationalFrame(const std::array<Eigen::Vector3d, 9>& x,
   A1_ = A1;
   d2pl_ = d2pl;
   director_derivatives_ = true;
+  director_curvature_ = true;
+}
+
+CorotationalFrame::CorotationalFrame(const std::array<Eigen::Vector3d, 9>& x, const std::array<Eigen::Vector3d, 9>& p,
+                                     const std::array<Eigen::Matrix<double, 3, 2>, 9>& A1,
+                                     const std::array<DirectorChart, 9>& charts)
+    : CorotationalFrame(x, p, charts) {
+  A1_ = A1;
+  director_derivatives_ = true;
+  director_curvature_ = false;
 }
 
 CorotationalFrame::CorotationalFrame(const std::array<Eigen::Vector3d, 9>& x, const std::array<Eigen::Vector3d, 9>& p,
                                      const std::array<DirectorChart, 9>& charts)
-    : p_(p), director_derivatives_(false) {
+    : p_(p), director_derivatives_(false), director_curvature_(false) {
   for (int i = 0; i < 9; ++i) l_[i] = charts[i].l;
   // §3.1 triad from the unit diagonals.
   a_ = x[2] - x[0];
@@ -137,8 +147,8 @@ CorotationalFrame::Vec45 CorotationalFrame::local_variables(const std::array<Eig
 
 namespace {
 
-// Error-free transformations (Knuth's TwoSum; TwoProduct by FMA when the target has it, else Dekker's
-// splitting): a op b = hi + lo exactly in binary64. Used by the compensated local translations below.
+// Error-free transformations (Knuth's TwoSum here; TwoProduct, by FMA when the target has it, else Dekker's
+// splitting, inline in local_variables() below): a op b = hi + lo exactly in binary64. Used by the compensated local translations below.
 struct DD {
   double hi = 0.0, lo = 0.0;
 };
@@ -147,19 +157,6 @@ inline DD two_sum(double a, double b) {
   const double s = a + b;
   const double bb = s - a;
   return {s, (a - (s - bb)) + (b - bb)};
-}
-
-inline DD two_prod(double a, double b) {
-  const double p = a * b;
-#ifdef __FMA__
-  return {p, std::fma(a, b, -p)};
-#else
-  constexpr double split = 134217729.0;  // 2^27 + 1
-  const double ca = split * a, cb = split * b;
-  const double ah = ca - (ca - a), bh = cb - (cb - b);
-  const double al = a - ah, bl = b - bh;
-  return {p, ((ah * bh - p) + ah * bl + al * bh) + al * bl};
-#endif
 }
 
 // (hi, lo) + (b_hi, b_lo), renormalised.
@@ -180,20 +177,59 @@ CorotationalFrame::Vec45 CorotationalFrame::local_variables(const std::array<Eig
     for (int k = 0; k < 4; ++k) acc = dd_add(acc, {disp[k](c), 0.0});
     dO[c] = {0.25 * acc.hi, 0.25 * acc.lo};  // exact scaling by a power of two
   }
-  Vec45 u;
-  for (int i = 0; i < 9; ++i) {
-    // rel_i = (X_i - X_O) + (d_i - d_O), exact to double-double.
-    std::array<DD, 3> rel;
-    for (int c = 0; c < 3; ++c)
-      rel[c] = dd_add(dd_add({rel_ref[i](c), 0.0}, {disp[i](c), 0.0}), {-dO[c].hi, -dO[c].lo});
-    for (int r = 0; r < 3; ++r) {
-      DD acc{-x_local0[i](r), 0.0};
-      for (int c = 0; c < 3; ++c) {
-        const DD p = two_prod(R_(c, r), rel[c].hi);
-        acc = dd_add(acc, {p.hi, p.lo + R_(c, r) * rel[c].lo});
-      }
-      u(5 * i + r) = acc.hi + acc.lo;
+  // The same operations as a node-by-node loop, laid out node-innermost (arrays over the 9 nodes, padded to 10
+  // with a zero node so that every loop is five whole SSE2 packets) so that the compiler runs them on all nodes
+  // at once in vector registers; without FMA the Dekker splits of R's entries and of rel's high parts are formed
+  // once each instead of once per product (the same values: bitwise the node-by-node results).
+  constexpr int n = 10;
+  // rel_i = (X_i - X_O) + (d_i - d_O), exact to double-double.
+  alignas(16) double rh[3][n], rl[3][n];
+  for (int c = 0; c < 3; ++c) {
+    alignas(16) double ref[n], d[n];
+    for (int i = 0; i < 9; ++i) ref[i] = rel_ref[i](c), d[i] = disp[i](c);
+    ref[9] = d[9] = 0.0;
+    for (int i = 0; i < n; ++i) {
+      const DD r = dd_add(dd_add({ref[i], 0.0}, {d[i], 0.0}), {-dO[c].hi, -dO[c].lo});
+      rh[c][i] = r.hi;
+      rl[c][i] = r.lo;
     }
+  }
+#ifndef __FMA__
+  constexpr double split = 134217729.0;  // 2^27 + 1 (Dekker)
+  alignas(16) double bh[3][n], bl[3][n];
+  for (int c = 0; c < 3; ++c)
+    for (int i = 0; i < n; ++i) {
+      const double cb = split * rh[c][i];
+      bh[c][i] = cb - (cb - rh[c][i]);
+      bl[c][i] = rh[c][i] - bh[c][i];
+    }
+#endif
+  Vec45 u;
+  for (int r = 0; r < 3; ++r) {
+    alignas(16) double ahi[n], alo[n];
+    for (int i = 0; i < 9; ++i) ahi[i] = -x_local0[i](r);
+    ahi[9] = 0.0;
+    for (int i = 0; i < n; ++i) alo[i] = 0.0;
+    for (int c = 0; c < 3; ++c) {
+      const double a = R_(c, r);
+#ifndef __FMA__
+      const double ca = split * a, ah = ca - (ca - a), al = a - ah;
+#endif
+      for (int i = 0; i < n; ++i) {
+        const double p = a * rh[c][i];
+#ifdef __FMA__
+        const double pe = std::fma(a, rh[c][i], -p);
+#else
+        const double pe = ((ah * bh[c][i] - p) + ah * bl[c][i] + al * bh[c][i]) + al * bl[c][i];  // two_prod's error
+#endif
+        const DD acc = dd_add({ahi[i], alo[i]}, {p, pe + a * rl[c][i]});
+        ahi[i] = acc.hi;
+        alo[i] = acc.lo;
+      }
+    }
+    for (int i = 0; i < 9; ++i) u(5 * i + r) = ahi[i] + alo[i];
+  }
+  for (int i = 0; i < 9; ++i) {
     u(5 * i + 3) = R_.col(0).dot(p_[i]);
     u(5 * i + 4) = R_.col(1).dot(p_[i]);
   }
@@ -281,6 +317,8 @@ void CorotationalFrame::tangent(const Mat45& kL, const Vec45& fL, bool geometric
 }
 
 void CorotationalFrame::add_geometric_stiffness(const Vec45& fL, Mat45* K) const {
+  if (!director_curvature_)
+    throw std::logic_error("CorotationalFrame: K_σ of a frame built without the directors' d²p_l/dq² (residual-only frame)");
   derivatives();
   // K_σ = Σ_j (f_L)_j ∂²(u_L)_j/∂u_G∂u_G, §3.4, through the weight vectors.
   const Weights w = weights(fL);

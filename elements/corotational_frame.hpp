@@ -35,6 +35,10 @@ class CorotationalFrame {
   // std::logic_error.
   CorotationalFrame(const std::array<Eigen::Vector3d, 9>& x, const std::array<Eigen::Vector3d, 9>& p,
                     const std::array<DirectorChart, 9>& charts);
+  // A frame for F = Tᵀ f_L (apply_transpose(), matrix()) without the directors' curvature d²p_l/dq² (a residual
+  // without a tangent): tangent() and add_geometric_stiffness() (K_σ's group 4 needs it) throw std::logic_error.
+  CorotationalFrame(const std::array<Eigen::Vector3d, 9>& x, const std::array<Eigen::Vector3d, 9>& p,
+                    const std::array<Eigen::Matrix<double, 3, 2>, 9>& A1, const std::array<DirectorChart, 9>& charts);
 
   const Eigen::Matrix3d& R() const { return R_; }
   const Eigen::Vector3d& origin() const { return xO_; }
@@ -95,6 +99,7 @@ class CorotationalFrame {
   Eigen::Matrix3d R_;
   // Derivative data (compute_derivatives(); mutable: filled lazily by const methods, one frame per thread).
   bool director_derivatives_ = true;  // false: built without A1, d2pl (local_variables() only)
+  bool director_curvature_ = true;    // false: built without d2pl (no K_σ)
   mutable bool have_derivatives_ = false, have_corner_columns_ = false;
   mutable Eigen::Matrix3d Pa_, Pb_, Ps_, Pc_;
   mutable std::array<std::array<Eigen::Matrix3d, 4>, 3> E_;

@@ -71,6 +71,41 @@ Covariant covariant(double xi, double eta, const std::array<Eigen::Vector3d, 9>&
   return c;
 }
 
+// Shape-function derivatives at the 20 τ points of the tying-point membrane form (cr9_shell.hpp, tying_):
+// column j = N_i,ξ (j < 6: family A; 12 ≤ j < 16: family C) or N_i,η (6 ≤ j < 12: family B; j ≥ 16: family C).
+const Eigen::Matrix<double, 9, 20>& tying_dN() {
+  static const Eigen::Matrix<double, 9, 20> D = [] {
+    Eigen::Matrix<double, 9, 20> d;
+    for (int k = 0; k < 6; ++k) {
+      d.col(k) = shape_derivatives(mitc9_family(0).xi[k], mitc9_family(0).eta[k]).col(0);
+      d.col(6 + k) = shape_derivatives(mitc9_family(1).xi[k], mitc9_family(1).eta[k]).col(1);
+    }
+    for (int k = 0; k < 4; ++k) {
+      const Eigen::Matrix<double, 9, 2> dN = shape_derivatives(mitc9_family(2).xi[k], mitc9_family(2).eta[k]);
+      d.col(12 + k) = dN.col(0);
+      d.col(16 + k) = dN.col(1);
+    }
+    return d;
+  }();
+  return D;
+}
+
+// D_τ with a zero tenth row (10 × 20): f_tᵀ = D_τ Gᵀ then runs as five whole SSE2 packets per column.
+const Eigen::Matrix<double, 10, 20>& tying_dN10() {
+  static const Eigen::Matrix<double, 10, 20> D = [] {
+    Eigen::Matrix<double, 10, 20> d = Eigen::Matrix<double, 10, 20>::Zero();
+    d.topRows<9>() = tying_dN();
+    return d;
+  }();
+  return D;
+}
+
+// Its transpose (20 × 9, column-major): the τ points' products run as 20-long column updates (vectorized).
+const Eigen::Matrix<double, 20, 9>& tying_dNT() {
+  static const Eigen::Matrix<double, 20, 9> DT = tying_dN().transpose();
+  return DT;
+}
+
 std::string node_name(int i) { return "node " + std::to_string(i + 1) + " (index " + std::to_string(i) + ")"; }
 
 void validate_material(const ShellMaterial& m) {
@@ -140,6 +175,10 @@ CR9Shell::CR9Shell(const std::array<Eigen::Vector3d, 9>& X0, const std::array<Ei
     const Mitc9Family& fam = mitc9_family(f);
     for (int k = 0; k < fam.count; ++k) tying[f][k] = covariant(fam.xi[k], fam.eta[k], xl0_, r0, L);
   }
+  tying_ = opt_.mitc && opt_.tying_membrane;
+  At_.setZero();
+  for (int k = 0; k < 6; ++k) Xt_.col(k) = tying[0][k].Xa[0], Xt_.col(6 + k) = tying[1][k].Xa[1];
+  for (int k = 0; k < 4; ++k) Xt_.col(12 + k) = tying[2][k].Xa[0], Xt_.col(16 + k) = tying[2][k].Xa[1];
 
   const double h = mat.thickness;
   const double G = mat.E / (2.0 * (1.0 + mat.nu));
@@ -205,6 +244,15 @@ CR9Shell::CR9Shell(const std::array<Eigen::Vector3d, 9>& X0, const std::array<Ei
           2.0 * j(0, 0) * j(1, 0), 2.0 * j(0, 1) * j(1, 1), 2.0 * (j(0, 0) * j(1, 1) + j(0, 1) * j(1, 0));
       GaussPoint& gp = gp_[3 * ig + jg];
       gp.dA = dA;
+      if (opt_.mitc) {  // ε_c = Σ_ab Tm(c, ab) Σ_k w_ab,k ê_ab,k (§4.4–4.5), the tying-point form's A
+        const int g = 3 * ig + jg;
+        const Eigen::Matrix<double, 6, 1> w0 = mitc9_weights(0, xi, eta), w1 = mitc9_weights(1, xi, eta),
+                                          w2 = mitc9_weights(2, xi, eta);
+        for (int c = 0; c < 3; ++c) {
+          for (int k = 0; k < 6; ++k) At_(3 * g + c, k) = Tm(c, 0) * w0(k), At_(3 * g + c, 6 + k) = Tm(c, 1) * w1(k);
+          for (int k = 0; k < 4; ++k) At_(3 * g + c, 12 + k) = Tm(c, 2) * w2(k);
+        }
+      }
       for (int c = 0; c < 3; ++c) {
         gp.Lm.row(c) = Tm(c, 0) * eL[0] + Tm(c, 1) * eL[1] + Tm(c, 2) * eL[2];
         gp.Hm[c] = Tm(c, 0) * eH[0] + Tm(c, 1) * eH[1] + Tm(c, 2) * eH[2];
@@ -230,6 +278,7 @@ CR9Shell::CR9Shell(const std::array<Eigen::Vector3d, 9>& X0, const std::array<Ei
         for (int i = 0; i <= j; ++i) Hp_(i + j * (j + 1) / 2, 3 * g + c) = gp.Hm[static_cast<size_t>(c)](i, j);
       dAall_(3 * g + c) = gp.dA;
     }
+  AtT_ = At_.transpose();
   for (int j = 0; j < 45; ++j)
     for (int i = 0; i <= j; ++i) Kbsp_(i + j * (j + 1) / 2) = Kbs_(i, j);
   for (int j = 0; j < 27; ++j)
@@ -287,20 +336,37 @@ CR9Shell::Vec45 CR9Shell::kbs_times(const Vec45& w) const {
   return y;
 }
 
-CorotationalFrame CR9Shell::local_increments(const Vec45& u, const Charts& charts, Vec45* w, bool derivatives) const {
+CorotationalFrame CR9Shell::local_increments(const Vec45& u, const Charts& charts, Vec45* w, bool derivatives,
+                                             bool curvature) const {
   std::array<Eigen::Vector3d, 9> x, p;
   std::array<Eigen::Matrix<double, 3, 2>, 9> A1;
   std::array<Eigen::Matrix2d, 9> d2;
   for (int i = 0; i < 9; ++i) {
     const Eigen::Vector2d q = u.segment<2>(5 * i + 3);
+    const DirectorChart& ch = charts[i];
     x[i] = X0_[i] + u.segment<3>(5 * i);
-    p[i] = director(q, charts[i]);
+    // p, A1 and d²p_l/dq² of §2.1–2.2 from one p_l: the expressions of director(), director_A1() and
+    // director_d2pl() (bitwise their values) without evaluating the square root three times.
+    const double r = 1.0 - q.squaredNorm();
+    if (!(r > 0.0)) director(q, ch);  // throws the §2.1 guard's std::domain_error
+    const double pl = ch.s * std::sqrt(r);
+    p[i](ch.n) = q(0);
+    p[i](ch.m) = q(1);
+    p[i](ch.l) = pl;
     if (derivatives) {
-      A1[i] = director_A1(q, charts[i]);
-      d2[i] = director_d2pl(q, charts[i]);
+      A1[i].row(ch.n) << 1.0, 0.0;
+      A1[i].row(ch.m) << 0.0, 1.0;
+      A1[i].row(ch.l) << -q(0) / pl, -q(1) / pl;
+      if (curvature) {
+        Eigen::Matrix2d H;
+        H << 1.0 - q(1) * q(1), q(0) * q(1), q(0) * q(1), 1.0 - q(0) * q(0);
+        d2[i] = (-1.0 / (pl * pl * pl)) * H;
+      }
     }
   }
-  const CorotationalFrame fr = derivatives ? CorotationalFrame(x, p, A1, d2, charts) : CorotationalFrame(x, p, charts);
+  const CorotationalFrame fr = !derivatives ? CorotationalFrame(x, p, charts)
+                               : curvature  ? CorotationalFrame(x, p, A1, d2, charts)
+                                            : CorotationalFrame(x, p, A1, charts);
   if (w) {
     std::array<Eigen::Vector3d, 9> d;
     for (int i = 0; i < 9; ++i) d[i] = u.segment<3>(5 * i);
@@ -314,7 +380,25 @@ CorotationalFrame CR9Shell::frame(const Vec45& u, const Charts& charts) const {
   return local_increments(u, charts, nullptr);
 }
 
+Eigen::Matrix<double, 3, 20> CR9Shell::tying_tau(const Mat39& t) const {
+  // τ_j = Σ_i N_i,a(point j) t_i, as τᵀ = D_τᵀ tᵀ: column-major 20-long columns, which Eigen's coefficient-based
+  // product evaluates packet-wise.
+  const Eigen::Matrix<double, 20, 3> tauT = tying_dNT().lazyProduct(t.transpose());
+  return tauT.transpose();
+}
+
 Eigen::Matrix<double, 27, 1> CR9Shell::membrane_strains(const Mat39& t) const {
+  if (tying_) {
+    // §4.4 tying-point strains ê_ab = ½(X_a·τ_b + X_b·τ_a + τ_a·τ_b), then ε = A ê (cr9_shell.hpp, tying_).
+    const Eigen::Matrix<double, 3, 20> tau = tying_tau(t);
+    Eigen::Matrix<double, 16, 1> eh;
+    for (int k = 0; k < 12; ++k) eh(k) = Xt_.col(k).dot(tau.col(k)) + 0.5 * tau.col(k).squaredNorm();
+    for (int k = 12; k < 16; ++k)
+      eh(k) = 0.5 * (Xt_.col(k).dot(tau.col(k + 4)) + Xt_.col(k + 4).dot(tau.col(k)) + tau.col(k).dot(tau.col(k + 4)));
+    Eigen::Matrix<double, 27, 1> e = At_.col(0) * eh(0);
+    for (int k = 1; k < 16; ++k) e.noalias() += At_.col(k) * eh(k);
+    return e;
+  }
   // ε_m,c at every Gauss point: L_m,c·t + ½ Σ_ij H_c(i,j) t_i·t_j = L_m,c·t + ½ H_c : (tᵀt)  (§4.5)
   // Packed Gram matrix with the off-diagonal entries doubled: Σ_ij H_ij G_ij = Σ_k Hp_k g_k.
   Eigen::Matrix<double, 45, 1> g;
@@ -390,6 +474,22 @@ double CR9Shell::membrane_force(const Mat39& t1, const Mat39& t0, double c1, dou
     U += membrane_energy(dA, eg, hD1);
     sN.segment<3>(3 * g) = dA * N;
   }
+  if (tying_) {
+    // Σ_gp dA B_mᵀ N = Σ_k μ_k ∂ê_k/∂t at t̄ = b1 t1 + b0 t0, μ = Aᵀ s (§4.4): ∂ê_ab/∂t_i =
+    // ½[N_i,b (X_a + τ̄_a) + N_i,a (X_b + τ̄_b)], so f_t = G D_τᵀ with G's column j the weight of τ point j.
+    Eigen::Matrix<double, 16, 1> mu = AtT_.col(0) * sN(0);
+    for (int k = 1; k < 27; ++k) mu.noalias() += AtT_.col(k) * sN(k);
+    const Eigen::Matrix<double, 3, 20> xb = Xt_ + tying_tau(b1 * t1 + b0 * t0);  // X_a + τ̄_a
+    Eigen::Matrix<double, 3, 20> G;
+    for (int k = 0; k < 12; ++k) G.col(k) = mu(k) * xb.col(k);
+    for (int k = 12; k < 16; ++k) {
+      G.col(k) = (0.5 * mu(k)) * xb.col(k + 4);
+      G.col(k + 4) = (0.5 * mu(k)) * xb.col(k);
+    }
+    const Eigen::Matrix<double, 10, 3> ftT = tying_dN10().lazyProduct(G.transpose());  // f_tᵀ = D_τ Gᵀ (row 9: 0)
+    for (int i = 0; i < 9; ++i) fL->segment<3>(5 * i) += ftT.row(i).transpose();
+    return U;
+  }
   // Σ_gp dA B_mᵀ N with B_m,c = L_m,c + (t̄ H_c) rows, t̄ = b1 t1 + b0 t0: Lᵀ s + t̄ Σ_gp,c s_gp,c H_c.
   Eigen::Matrix<double, 27, 1> fm = Eigen::Matrix<double, 27, 1>::Zero();
   for (const int j : lcols_) fm(j) = Lall_.col(j).dot(sN);
@@ -427,7 +527,7 @@ double CR9Shell::local(const Vec45& u, const Charts& charts, Vec45* uL, Vec45* f
 
 double CR9Shell::internal(const Vec45& u, const Charts& charts, Vec45* F, Mat45* K) const {
   Vec45 w;
-  const CorotationalFrame fr = local_increments(u, charts, &w);
+  const CorotationalFrame fr = local_increments(u, charts, &w, true, K != nullptr);
   Vec45 fL = Kbs_ * w;
   double U = 0.5 * w.dot(fL);
   const Mat39 t = translations(w);
@@ -436,7 +536,14 @@ double CR9Shell::internal(const Vec45& u, const Charts& charts, Vec45* F, Mat45*
     U += membrane(t, t, 1.0, 0.0, 1.0, 0.0, &fL, &kL);
     fr.tangent(kL, fL, opt_.geometric_stiffness, K);  // §3.4 K = T^T k_L T + K_σ
   } else {
-    U += membrane(t, t, 1.0, 0.0, 1.0, 0.0, &fL, nullptr);
+    // The force alone: membrane_force() (no B_m matrices formed) with c0 = b0 = 0, so the state of t0 is unused.
+    static const StepState unused = [] {
+      StepState z;
+      z.w.setZero(), z.Kw.setZero();
+      for (auto& e : z.e) e.setZero();
+      return z;
+    }();
+    U += membrane_force(t, t, 1.0, 0.0, 1.0, 0.0, unused, &fL);
   }
   if (F) *F = fr.apply_transpose(fL);  // §3.4 F = T^T f_L
   return U;
@@ -502,7 +609,7 @@ double CR9Shell::algorithmic_internal(const StepState& sn, const Vec45& u_n, con
   Vec45 w1;
   local_increments(u_np1, charts, &w1, false);  // the frame at u_np1 serves w1 only (its derivatives are never formed)
   const Vec45 u_mid = (1.0 - alpha_f) * u_np1 + alpha_f * u_n;
-  const CorotationalFrame fr = local_increments(u_mid, charts, nullptr);
+  const CorotationalFrame fr = local_increments(u_mid, charts, nullptr, true, K != nullptr);
   const double c1 = 1.0 - alpha_f + xi, c0 = alpha_f - xi;
   if (!K) {  // residual: K_bs w_n from the step state, membrane force without its tangent
     const Vec45 Kw1 = kbs_times(w1);

@@ -41,6 +41,10 @@ struct ShellMaterial {
 struct CR9ShellOptions {
   bool mitc = true;
   bool geometric_stiffness = true;
+  // MITC9 membrane strains and force from the 16 tying-point strains (docs/theory.md §4.4, the tying-point
+  // form of membrane_strains()); false: the Gauss-point matrices L_m, H_m of §4.5 (the reference path the
+  // tests compare against; same quantities to round-off). No effect when mitc = false.
+  bool tying_membrane = true;
 };
 
 class CR9Shell {
@@ -136,7 +140,9 @@ class CR9Shell {
   Eigen::Matrix<double, 27, 1> membrane_strains(const Mat39& t) const;
   // Local increments w = [t_i, Δθ_i] of u and the frame at u. derivatives = false: a frame for w only (the
   // directors' A1 and d2pl are not evaluated; the frame's derivatives cannot be formed).
-  CorotationalFrame local_increments(const Vec45& u, const Charts& charts, Vec45* w, bool derivatives = true) const;
+  // curvature = false: the frame has the directors' A1 but not d²p_l/dq² (F = Tᵀf_L only, no K_σ).
+  CorotationalFrame local_increments(const Vec45& u, const Charts& charts, Vec45* w, bool derivatives = true,
+                                     bool curvature = true) const;
 
   std::array<Eigen::Vector3d, 9> X0_;
   std::array<Eigen::Vector3d, 9> xl0_;  // initial local coordinates x_i0 (§3.2)
@@ -159,6 +165,18 @@ class CR9Shell {
   std::vector<int> kbs_active_;
   Eigen::MatrixXd kbs_block_;  // its product runs as a fixed-size one for the common sizes 27 (flat) and 36
   Vec45 kbs_times(const Vec45& w) const;  // Kbs_ w from Kbsp_ or kbs_block_
+  // Tying-point form of the MITC9 membrane strains (§4.4; used when opt_.mitc && opt_.tying_membrane). The
+  // covariant membrane strain of tying point k is ê_ab = ½(X_a·τ_b + X_b·τ_a + τ_a·τ_b) with τ_a = Σ_i N_i,a t_i
+  // there, and the Gauss-point Cartesian strains are ε = A ê (A = Tm · MITC9 weights). The 20 "τ points":
+  // columns 0–5 ∂/∂ξ at family A, 6–11 ∂/∂η at family B, 12–15 ∂/∂ξ and 16–19 ∂/∂η at family C (the
+  // shape-function derivatives there are element-independent, tying_dN() in the .cpp). ~1 100 multiplications
+  // per strain evaluation and ~1 600 per force instead of ~2 000 and ~2 200 through L_m, H_m, reading 7.5 kB
+  // of membrane data per residual instead of 15.5 kB (Hp_, Lall_).
+  bool tying_ = false;
+  Eigen::Matrix<double, 3, 20> Xt_;   // X_ξ or X_η (local reference geometry) at the τ points
+  Eigen::Matrix<double, 27, 16> At_;  // row 3g + c: ε_c at Gauss point g from ê
+  Eigen::Matrix<double, 16, 27> AtT_; // its transpose (μ = Aᵀ s as 16-long column updates)
+  Eigen::Matrix<double, 3, 20> tying_tau(const Mat39& t) const;
   Mat45 Kbs_;                           // constant bending + shear stiffness Σ dA (B_b^T M + B_s^T Q)
   std::array<Eigen::Matrix<double, 5, 45>, 9> Bbs_;  // [B_b; B_s] per Gauss point (output only)
   Eigen::Matrix<double, 9, 9> m_;
