@@ -71,6 +71,19 @@ BorderedNewton::BorderedNewton(std::shared_ptr<const SparsePattern> pattern, Bor
 
 BorderedNewton::Result BorderedNewton::solve(const DofMap& dofs, const Eigen::VectorXd& u_n, Eigen::VectorXd& u,
                                              Eigen::VectorXd& lambda, Index m, const Callbacks& cb) {
+  // A callback that cannot evaluate an iterate (e.g. a director chart overshot, std::domain_error) fails the step,
+  // as KINSOL's callbacks do in the unconstrained steps: the integrator retries or cuts it.
+  Result res;
+  try {
+    return solve_impl(dofs, u_n, u, lambda, m, cb);
+  } catch (const std::exception& e) {
+    res.message = e.what();
+    return res;
+  }
+}
+
+BorderedNewton::Result BorderedNewton::solve_impl(const DofMap& dofs, const Eigen::VectorXd& u_n, Eigen::VectorXd& u,
+                                                  Eigen::VectorXd& lambda, Index m, const Callbacks& cb) {
   const Index n = u.size();
   if (lambda.size() != m) lambda = Eigen::VectorXd::Zero(m);
   const Eigen::ArrayXd uscale = 1.0 / u_n.array().abs().max(1.0);

@@ -80,6 +80,8 @@ class BorderedNewton {
                const Callbacks& cb);
 
  private:
+  Result solve_impl(const DofMap& dofs, const Eigen::VectorXd& u_n, Eigen::VectorXd& u, Eigen::VectorXd& lambda, Index m,
+                    const Callbacks& cb);
   BorderedNewtonOptions opt_;
   std::unique_ptr<LinearSolver> solver_;
   SparseMatrix J_;
