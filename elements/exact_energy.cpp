@@ -18,6 +18,8 @@ MidpointRigidRows::MidpointRigidRows(const NodeVectors& x_mid, const NodeVectors
   c /= 9.0;
   Eigen::Vector3d s = Eigen::Vector3d::Zero();
   Eigen::Matrix3d J = Eigen::Matrix3d::Zero();
+  Jd_.setZero();
+  Jq_.setZero();
   for (int i = 0; i < 9; ++i) {
     const Eigen::Vector3d r = x_mid[i] - c;
     r_[i] = r;
@@ -32,6 +34,11 @@ MidpointRigidRows::MidpointRigidRows(const NodeVectors& x_mid, const NodeVectors
     for (int j = 0; j < 3; ++j) ul[j] = Eigen::Vector3d::Unit(j).cross(p)[l];
     J.noalias() -= p * p.transpose() + ul * ul.transpose();
     J.diagonal().array() += p.squaredNorm();
+    // The two parts of the rotation block apart (the weighted correction of theory §3 scales the director part).
+    Jd_.noalias() -= r * r.transpose();
+    Jd_.diagonal().array() += r.squaredNorm();
+    Jq_.noalias() -= p * p.transpose() + ul * ul.transpose();
+    Jq_.diagonal().array() += p.squaredNorm();
   }
   gram_.setZero();
   gram_.topLeftCorner<3, 3>().diagonal().setConstant(9.0);
@@ -85,7 +92,7 @@ RigidRows MidpointRigidRows::dense() const {
 }
 
 CorrectionInfo energy_momentum_correction(const MidpointRigidRows& R, const Vec45E& du, double dU, Vec45E& F,
-                                          double guard) {
+                                          double guard, double director_weight) {
   // (RRᵀ)⁻¹ [R F, R Δu] by block elimination: RRᵀ = [9I, B; Bᵀ, J] (the translation block is 9I, B is zero up to the
   // rounding of the centroid), so the rotation part solves with the 3 × 3 Schur complement J − BᵀB/9 and the
   // translation part follows. Cheaper than a 6 × 6 Cholesky per element and residual, and as accurate.
@@ -102,15 +109,32 @@ CorrectionInfo energy_momentum_correction(const MidpointRigidRows& R, const Vec4
   R.subtract_transpose_times(sol.col(0), F);
   // z = Δu with its midpoint-rigid part removed (R z = 0, Δuᵀ z = zᵀ z).
   Vec45E z = du;
-  R.subtract_transpose_times(sol.col(1), z);
   CorrectionInfo info;
-  info.z_norm2 = z.squaredNorm();
+  if (director_weight == 1.0) {
+    R.subtract_transpose_times(sol.col(1), z);
+    info.z_norm2 = z.squaredNorm();
+  } else {
+    // In the metric W = diag(1 on d, w on q) (theory §3): R W Rᵀ y = R W Δu, z = W(Δu − Rᵀy). R W Rᵀ is RRᵀ with the
+    // director part of its rotation block scaled by w (the translation rows have no q-slots).
+    Vec45E Wdu = du;
+    for (int i = 0; i < 9; ++i) Wdu.segment<2>(5 * i + 3) *= director_weight;
+    const Eigen::Matrix3d Jw = R.translation_gram() + director_weight * R.director_gram();
+    const Eigen::LLT<Eigen::Matrix3d> Sw(Jw - B.transpose() * B / 9.0);
+    if (Sw.info() != Eigen::Success) throw std::domain_error("energy_momentum_correction: singular rigid rows");
+    Eigen::Matrix<double, 6, 1> y = R.times(Wdu);
+    y.tail<3>() = Sw.solve(y.tail<3>() - B.transpose() * y.head<3>() / 9.0);
+    y.head<3>() = (y.head<3>() - B * y.tail<3>()) / 9.0;
+    R.subtract_transpose_times(y, z);
+    for (int i = 0; i < 9; ++i) z.segment<2>(5 * i + 3) *= director_weight;
+    info.z_norm2 = du.dot(z);  // ‖Δu − Rᵀy‖²_W
+  }
   if (info.z_norm2 <= guard * du.squaredNorm() || info.z_norm2 == 0.0) {
     info.rigid_guard = true;  // rigid step: ΔU = 0 = Δuᵀ(F + Rᵀa) analytically (theory §3, Cayley)
     return info;
   }
   info.beta = (dU - du.dot(F)) / info.z_norm2;
   F.noalias() += info.beta * z;
+  info.correction_norm = std::abs(info.beta) * z.norm();
   return info;
 }
 

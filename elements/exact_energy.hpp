@@ -42,23 +42,33 @@ class MidpointRigidRows {
   Vec6 times(const Vec45E& f) const;                        // R f
   void subtract_transpose_times(const Vec6& a, Vec45E& y) const;  // y −= Rᵀa
   const Eigen::Matrix<double, 6, 6>& gram() const { return gram_; }  // R Rᵀ
+  // The rotation block of R Rᵀ split into its d-slot part Σ_i (e_j × r_i)·(e_k × r_i) and its director part
+  // Σ_i (S_i(e_j × p_i))·(S_i(e_k × p_i)) (their sum is the block up to rounding).
+  const Eigen::Matrix3d& translation_gram() const { return Jd_; }
+  const Eigen::Matrix3d& director_gram() const { return Jq_; }
   RigidRows dense() const;                                  // the 6 × 45 rows (projector, tests)
 
  private:
   NodeVectors r_, p_;
   std::array<DirectorChart, 9> charts_;
   Eigen::Matrix<double, 6, 6> gram_;
+  Eigen::Matrix3d Jd_, Jq_;
 };
 
 struct CorrectionInfo {
   double beta = 0.0;         // the coefficient of z
-  double z_norm2 = 0.0;      // zᵀz
+  double z_norm2 = 0.0;      // zᵀz (= Δuᵀz; Δuᵀz with a director weight)
+  double correction_norm = 0.0;  // ‖β z‖₂
   bool rigid_guard = false;  // β set to 0 because the step is (numerically) rigid
 };
 
 // Replaces F by F* of item 2. du = u_{n+1} − u_n (element DOFs, same charts), dU = U(u_{n+1}) − U(u_n).
+// director_weight w ≠ 1 takes the correction's direction in the metric W = diag(1 on the translations, w on the
+// director coordinates): z = W(Δu − Rᵀy) with R W Rᵀ y = R W Δu, so R z = 0 and Δuᵀz = ‖Δu − Rᵀy‖²_W, and β = m/Δuᵀz
+// (z_norm2 reports Δuᵀz). The Model uses w = h ℓ_e (thickness times element size)
+// (docs/theory/exact-energy-momentum.md §3: with w = 1 the β z term swamps the director stiffness of thin shells).
 CorrectionInfo energy_momentum_correction(const MidpointRigidRows& R, const Vec45E& du, double dU, Vec45E& F,
-                                          double guard = 1e-20);
+                                          double guard = 1e-20, double director_weight = 1.0);
 
 // Projector Π = I − Rᵀ(RRᵀ)⁻¹R onto the complement of the rigid rows (ΠRᵀ = 0, Π symmetric).
 Eigen::Matrix<double, 45, 45> rigid_complement_projector(const RigidRows& R);

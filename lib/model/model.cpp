@@ -699,9 +699,17 @@ double Model::exact_internal(const Eigen::VectorXd& u_n, const Eigen::VectorXd& 
     }
     if (correct) {  // theory §3: R F* = 0, Δuᵀ F* = ΔU
       const double fmax = fe.cwiseAbs().maxCoeff();
-      const CorrectionInfo ci = energy_momentum_correction(*R, du, U1 - U_n[static_cast<size_t>(e)], fe);
+      // The correction's direction in the metric W = diag(1 on d, w on q), w = h ℓ_e (theory §3): ℓ_e = the reference
+      // element's largest node distance / √2 (its side for a square).
+      double diag2 = 0.0;
+      const auto& en = mesh_.elements[static_cast<size_t>(e)];
+      for (size_t a = 0; a < 9; ++a)
+        for (size_t b = a + 1; b < 9; ++b)
+          diag2 = std::max(diag2, (mesh_.X[static_cast<size_t>(en[a])] - mesh_.X[static_cast<size_t>(en[b])]).squaredNorm());
+      const double w = material_.thickness * std::sqrt(0.5 * diag2);
+      const CorrectionInfo ci = energy_momentum_correction(*R, du, U1 - U_n[static_cast<size_t>(e)], fe, 1e-20, w);
       guard[static_cast<size_t>(e)] = ci.rigid_guard;
-      if (fmax > 0.0) beta_z[static_cast<size_t>(e)] = std::abs(ci.beta) * std::sqrt(ci.z_norm2) / fmax;
+      if (fmax > 0.0) beta_z[static_cast<size_t>(e)] = ci.correction_norm / fmax;
     }
     if (xi > 0.0) {  // theory §6: ξ G Δu with G = Π Tᵀ k0 T Π (PSD, G Rᵀ = 0)
       const CR9Shell::Vec45 um = 0.5 * (un + u1);
