@@ -633,8 +633,8 @@ std::string study_file_path(const std::string& name) {
   }
   std::error_code ec;
   if (fs::exists(name, ec)) return name;  // load_study_file refuses what is not a regular file
-  throw std::invalid_argument("study: unknown benchmark or study file '" + name + "' (shipped: " + (names.empty() ? "none found" : names) +
-                              ", all; or the path of a study file)");
+  throw std::invalid_argument("study: unknown benchmark '" + name + "' (available: " + (names.empty() ? "none shipped" : names) +
+                              ", all, or the path of a study file)");
 }
 
 // The study's case: --case, else the study file's `case:` relative to the study file, else a shipped case.

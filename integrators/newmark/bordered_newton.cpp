@@ -1,5 +1,6 @@
 // Bordered Newton of constrained steps (docs/theory/multibody.md §9; header for the equations).
 #include "integrators/newmark/bordered_newton.hpp"
+#include "integrators/newmark/consistent_acceleration.hpp"
 
 #include "lib/model/assembler.hpp"
 
@@ -198,14 +199,9 @@ BorderedNewton::Result BorderedNewton::solve_impl(const DofMap& dofs, const Eige
 void constrained_acceleration(const SemiDiscreteSystem& sys, const State& s, const std::string& linear_solver,
                               Eigen::VectorXd& a, Eigen::VectorXd* lambda) {
   const Index n = sys.num_dofs(), m = sys.num_constraints();
-  SparseMatrix M{sys.pattern(), std::vector<double>(static_cast<size_t>(sys.pattern()->nnz()), 0.0)};
-  Eigen::VectorXd fint = Eigen::VectorXd::Zero(n), fm = Eigen::VectorXd::Zero(n), fext = Eigen::VectorXd::Zero(n);
-  sys.mass(s.u, s.charts, M);
-  sys.internal(s.u, s.charts, fint.data(), nullptr);
-  sys.inertial(s.u, s.v, s.charts, fm.data());
-  sys.external(s.t, s.u, s.charts, fext.data());
-  Eigen::VectorXd rhs = fext - fint - fm;
-  apply_dirichlet(sys.dofs(), M, rhs.data());
+  SparseMatrix M;
+  Eigen::VectorXd rhs;
+  acceleration_system(sys, s, M, rhs);
   auto solver = make_linear_solver(linear_solver);
   a.resize(n);
   if (m == 0) {

@@ -15,5 +15,7 @@ namespace shelldyn {
 // lib/linalg/linear_solver.hpp). F_m includes the system's damping force C v, if it has one.
 void consistent_acceleration(const SemiDiscreteSystem& sys, const State& s, const std::string& linear_solver,
                              Eigen::VectorXd& a);
+// The system both solve: M = M(u) and rhs = F_ext − F_int − F_m, with the Dirichlet rows applied (M on sys.pattern()).
+void acceleration_system(const SemiDiscreteSystem& sys, const State& s, SparseMatrix& M, Eigen::VectorXd& rhs);
 
 }  // namespace shelldyn

@@ -676,22 +676,7 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
       an_ = (2.0 / h) * dv_ - an_;  // dv_ = v_{n+1} − v_n of the accepted iterate (kinematics() above)
       wan_ = 2.0 * wdot_ - wan_;
     }
-    // New state: v, w from the trapezoidal relations; q̇ and q̈ entries hold the chart's minor components of
-    // w and Δw/Δt (for output only: the scheme's state is (d, p, v, w)); a_d = Δv/Δt.
-    for (int i = 0; i < nn_; ++i) {
-      const Index k = DofMap::dof(i, 0);
-      const DirectorChart& ch = charts[static_cast<size_t>(i)];
-      s.v.segment<3>(k) = v1_.segment<3>(3 * i);
-      s.a.segment<3>(k) = (v1_.segment<3>(3 * i) - vn_.segment<3>(3 * i)) / h;
-      s.v.segment<2>(k + 3) = chart_coordinates(Vec3(w1_.segment<3>(3 * i)), ch);
-      s.a.segment<2>(k + 3) = chart_coordinates(Vec3(wdot_.segment<3>(3 * i)), ch);
-    }
-    s.pdot = w1_;
-    s.u = u;
-    s.t = t1;
-    ++steps_;
-    ++rep.steps;
-    rep.last_dt = h;
+    accept_step(s, u, t1, h, charts, rep);
     return true;
   }
 
@@ -822,7 +807,15 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
     }
     work_ += dw;
     wdot_ = (w1_ - wn_) / h;
-    for (int i = 0; i < nn_; ++i) {  // as step()
+    accept_step(s, u, t1, h, charts, rep);
+    return true;
+  }
+  // The accepted step's end state of the shell nodes (step() and step_constrained()): v, w from the trapezoidal
+  // relations; q̇ and q̈ entries hold the chart's minor components of w and Δw/Δt (for output only: the scheme's state
+  // is (d, p, v, w)); a_d = Δv/Δt.
+  void accept_step(State& s, const Eigen::VectorXd& u, double t1, double h, const std::vector<DirectorChart>& charts,
+                   StepReport& rep) {
+    for (int i = 0; i < nn_; ++i) {
       const Index k = DofMap::dof(i, 0);
       const DirectorChart& ch = charts[static_cast<size_t>(i)];
       s.v.segment<3>(k) = v1_.segment<3>(3 * i);
@@ -836,8 +829,8 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
     ++steps_;
     ++rep.steps;
     rep.last_dt = h;
-    return true;
   }
+
   std::unique_ptr<BorderedNewton> bordered_, bordered_full_;  // constrained steps (full: the retry)
   Eigen::VectorXd lambda_;                                    // the last step's multipliers (the next guess)
 

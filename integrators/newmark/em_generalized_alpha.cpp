@@ -333,21 +333,7 @@ class NewmarkFamily final : public Integrator {
       const Eigen::Map<const Eigen::VectorXd> uu(u, n);
       midpoint_state(u);
       sys.mass(umid_, charts, M_);
-      switch (scheme_) {
-        case Scheme::EmGalpha:
-          sys.algorithmic_internal(un_, uu, charts, af, xi_, nullptr, &K_);
-          sys.add_load_stiffness(tmid, umid_, charts, K_);
-          break;
-        case Scheme::Midpoint:
-          sys.internal(umid_, charts, nullptr, &K_);
-          sys.add_load_stiffness(tmid, umid_, charts, K_);
-          break;
-        case Scheme::Galpha:
-        case Scheme::Newmark:
-          sys.internal(uu, charts, nullptr, &K_);
-          sys.add_load_stiffness(t1, uu, charts, K_);
-          break;
-      }
+      scheme_stiffness(sys, uu, charts, af, tmid, t1);
       // §6.4: K̄ = (1−α_m)/(βΔt²) M_mid + (1−α_f) K_mid (symmetric; the (1−α_m) reading of §6.8 item 3).
       profile::Scope prof(profile::Section::combine);
       for (size_t k = 0; k < J.values.size(); ++k) J.values[k] = du * M_.values[k] + (1 - af) * K_.values[k];
@@ -491,21 +477,7 @@ class NewmarkFamily final : public Integrator {
     cb.jacobian = [&](const Eigen::VectorXd& uu, SparseMatrix& J) {  // as step()'s K̄ (§6.4)
       midpoint_state(uu);
       sys.mass(umid_, charts, M_);
-      switch (scheme_) {
-        case Scheme::EmGalpha:
-          sys.algorithmic_internal(un_, uu, charts, af, xi_, nullptr, &K_);
-          sys.add_load_stiffness(tmid, umid_, charts, K_);
-          break;
-        case Scheme::Midpoint:
-          sys.internal(umid_, charts, nullptr, &K_);
-          sys.add_load_stiffness(tmid, umid_, charts, K_);
-          break;
-        case Scheme::Galpha:
-        case Scheme::Newmark:
-          sys.internal(uu, charts, nullptr, &K_);
-          sys.add_load_stiffness(t1, uu, charts, K_);
-          break;
-      }
+      scheme_stiffness(sys, uu, charts, af, tmid, t1);
       for (size_t k = 0; k < J.values.size(); ++k) J.values[k] = du * M_.values[k] + (1 - af) * K_.values[k];
       sys.add_damping_matrix(cu, J);
     };
@@ -581,6 +553,29 @@ class NewmarkFamily final : public Integrator {
 
   Scheme scheme_;
   std::string name_;
+  // K_ = the scheme's stiffness at the iterate u_{n+1} = uu (§6.4), umid_ already set: the strain-averaged tangent
+  // (em-galpha), the midpoint tangent (midpoint) or the end-point tangent (galpha, newmark), load stiffness added.
+  // (V: the Eigen vector or map the caller holds the iterate in, passed on as it is.)
+  template <class V>
+  void scheme_stiffness(const SemiDiscreteSystem& sys, const V& uu, const std::vector<DirectorChart>& charts, double af,
+                        double tmid, double t1) {
+    switch (scheme_) {
+      case Scheme::EmGalpha:
+        sys.algorithmic_internal(un_, uu, charts, af, xi_, nullptr, &K_);
+        sys.add_load_stiffness(tmid, umid_, charts, K_);
+        break;
+      case Scheme::Midpoint:
+        sys.internal(umid_, charts, nullptr, &K_);
+        sys.add_load_stiffness(tmid, umid_, charts, K_);
+        break;
+      case Scheme::Galpha:
+      case Scheme::Newmark:
+        sys.internal(uu, charts, nullptr, &K_);
+        sys.add_load_stiffness(t1, uu, charts, K_);
+        break;
+    }
+  }
+
   double dt_;
   GeneralizedAlphaParameters p_{};
   double xi_ = 0.0;
