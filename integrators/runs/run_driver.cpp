@@ -31,6 +31,16 @@
 namespace shelldyn {
 namespace {
 
+// Whether the run reports W_presc (docs/theory.md §8.6): prescribed displacement histories, or a prescribed_rotation
+// joint, whose multipliers do the driver's work λ·∂g/∂t (docs/manual.md §2.13).
+bool reports_prescribed_work(const Model& model) {
+  if (model.has_prescribed_motion()) return true;
+  if (const ModelMultibody* mb = model.multibody())
+    for (const JointDef& j : mb->joints())
+      if (j.type == JointDef::Type::prescribed_rotation) return true;
+  return false;
+}
+
 using Clock = std::chrono::steady_clock;
 
 void fill_summary_json(JsonFields& j, const RunSummary& s) {
@@ -322,7 +332,7 @@ RunSummary run_dynamic(Problem& problem, const RunOptions& o) {
   sum.settings = integrator->settings();
   sum.t_end = t_end;
   sum.damped = model.has_damping();  // the summary then names H = K + V − W_ext + W_damp
-  sum.prescribed = model.has_prescribed_motion();  // ... and − W_presc
+  sum.prescribed = reports_prescribed_work(model);  // ... and − W_presc
   spec.integrator.name = sum.integrator;  // run.json shows what was actually run
   spec.integrator.settings = sum.settings;
   spec.time.dt = dt;
@@ -373,10 +383,11 @@ RunSummary run_dynamic(Problem& problem, const RunOptions& o) {
     std::vector<std::string> names;
     for (const auto& m : monitors) names.push_back(m.name);
     // damping_work: energy dissipated by Rayleigh damping (docs/theory.md §8.5), only for damped models.
-    // prescribed_work: work of the prescribed displacement histories (docs/theory.md §8.6), only when there are some.
+    // prescribed_work: work of the prescribed displacement histories (docs/theory.md §8.6) or of the driven joints
+    // (prescribed_rotation), only when there are some.
     std::vector<std::string> extra;
     if (model.has_damping()) extra.push_back("damping_work");
-    if (model.has_prescribed_motion()) extra.push_back("prescribed_work");
+    if (sum.prescribed) extra.push_back("prescribed_work");
     // g_norm = ‖g(u)‖∞, gdot_norm = ‖G u̇ + ∂g/∂t‖∞: constraint drift at the output state (joints only).
     if (model.num_constraints() > 0) {
       extra.push_back("g_norm");
@@ -581,7 +592,7 @@ RunSummary run_dynamic(Problem& problem, const RunOptions& o) {
       row.wall_s = wall;
       row.monitors = mon;
       if (model.has_damping()) row.extra.push_back(integrator->damping_work());
-      if (model.has_prescribed_motion()) row.extra.push_back(integrator->prescribed_work());
+      if (sum.prescribed) row.extra.push_back(integrator->prescribed_work());
       if (model.num_constraints() > 0) {
         const auto [g_norm, gdot_norm] = constraint_drift(model, state);
         row.extra.push_back(g_norm);

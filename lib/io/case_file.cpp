@@ -399,9 +399,9 @@ InitialVelocitySpec parse_initial_velocity(const Parser& p, const YAML::Node& n,
 }
 
 TimeFunction parse_function(const Parser& p, const YAML::Node& n, const std::string& path) {
-  if (!n.IsMap()) p.fail(n, path, "expected a mapping {type: constant|ramp|hat|triangle|table, ...}, got a " + node_kind(n));
-  if (!n["type"]) p.fail(n, path + ".type", "missing required key 'type' (constant, ramp, hat, triangle or table)");
-  const size_t kind = p.choice(n["type"], path + ".type", {"constant", "ramp", "hat", "triangle", "table"});
+  if (!n.IsMap()) p.fail(n, path, "expected a mapping {type: constant|ramp|hat|triangle|table|spin_up, ...}, got a " + node_kind(n));
+  if (!n["type"]) p.fail(n, path + ".type", "missing required key 'type' (constant, ramp, hat, triangle, table or spin_up)");
+  const size_t kind = p.choice(n["type"], path + ".type", {"constant", "ramp", "hat", "triangle", "table", "spin_up"});
   try {
     switch (kind) {
       case 0:
@@ -417,6 +417,9 @@ TimeFunction parse_function(const Parser& p, const YAML::Node& n, const std::str
         p.check_keys(n, path, {"type", "t_peak", "t_end"}, {"type", "t_peak", "t_end"});
         return TimeFunction::triangle(p.positive(n["t_peak"], path + ".t_peak"),
                                       p.positive(n["t_end"], path + ".t_end"));
+      case 5:
+        p.check_keys(n, path, {"type", "T_s"}, {"type", "T_s"});
+        return TimeFunction::spin_up(p.positive(n["T_s"], path + ".T_s"));
       default: {
         p.check_keys(n, path, {"type", "points"}, {"type", "points"});
         const YAML::Node pts = n["points"];

@@ -30,7 +30,7 @@
 //                     or a list of such entries (later ones override earlier ones)         optional
 //   initial_displacement: {field: fields/step_N.vtu | u.csv}  (displacement and director of a run)  optional
 //   loads: [{set, type: force|moment, direction, amplitude, [distribution: per_node|edge_total|per_length],
-//            [function: {type: constant|ramp|hat|triangle|table, ...}]}
+//            [function: {type: constant|ramp|hat|triangle|table|spin_up, ...}]}
 //          | {[set = all], type: pressure|follower_pressure, amplitude, [function]}
 //          | {[set = all], type: body_force|gravity, direction, amplitude, [function]}, ...]   optional
 //   prescribed_displacements: [{set, dofs: [ux|uy|uz, ...], value, [function]}, ...]  optional

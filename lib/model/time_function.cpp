@@ -10,6 +10,8 @@ namespace shelldyn {
 
 namespace {
 
+constexpr double kPi = 3.14159265358979323846;
+
 void require_positive(double v, const char* name, const char* kind) {
   if (!std::isfinite(v) || v <= 0.0) {
     std::ostringstream os;
@@ -63,6 +65,11 @@ TimeFunction TimeFunction::table(std::vector<std::pair<double, double>> points) 
   return f;
 }
 
+TimeFunction TimeFunction::spin_up(double T_s) {
+  require_positive(T_s, "T_s", "spin_up");
+  return TimeFunction(Kind::SpinUp, T_s, 0.0);
+}
+
 double TimeFunction::operator()(double t) const {
   switch (kind_) {
     case Kind::Constant:
@@ -85,6 +92,13 @@ double TimeFunction::operator()(double t) const {
       auto lo = hi - 1;
       const double w = (t - lo->first) / (hi->first - lo->first);
       return (1.0 - w) * lo->second + w * hi->second;
+    }
+    case Kind::SpinUp: {
+      // Kane, Ryan & Banerjee 1987: θ/ω_s = (1/T)[t²/2 + (T/2π)²(cos(2πt/T) − 1)] for t ≤ T, t − T/2 after.
+      if (t <= 0.0) return 0.0;
+      if (t >= a_) return t - 0.5 * a_;
+      const double c = a_ / (2.0 * kPi);  // T/2π
+      return (0.5 * t * t + c * c * (std::cos(t / c) - 1.0)) / a_;
     }
   }
   return 0.0;  // unreachable; keeps -Wreturn-type quiet
@@ -110,6 +124,13 @@ double TimeFunction::rate(double t) const {
       auto lo = hi - 1;
       return (hi->second - lo->second) / (hi->first - lo->first);
     }
+    case Kind::SpinUp: {
+      // d/dt of the above: (1/T)[t − (T/2π) sin(2πt/T)], 1 after T.
+      if (t <= 0.0) return 0.0;
+      if (t >= a_) return 1.0;
+      const double c = a_ / (2.0 * kPi);  // T/2π
+      return (t - c * std::sin(t / c)) / a_;
+    }
   }
   return 0.0;
 }
@@ -130,6 +151,8 @@ double TimeFunction::end_of_variation() const {
       while (k > 0 && points_[k - 1].second == points_.back().second) --k;
       return k == 0 ? 0.0 : std::max(points_[k].first, 0.0);
     }
+    case Kind::SpinUp:
+      return std::numeric_limits<double>::infinity();  // grows linearly for ever
   }
   return std::numeric_limits<double>::infinity();
 }
@@ -139,6 +162,7 @@ double TimeFunction::end_of_support() const {
   switch (kind_) {
     case Kind::Constant:
     case Kind::Ramp:
+    case Kind::SpinUp:
       return inf;
     case Kind::Hat:
       return 2.0 * a_;
@@ -163,6 +187,7 @@ const char* TimeFunction::kind_name() const {
     case Kind::Hat: return "hat";
     case Kind::Triangle: return "triangle";
     case Kind::Table: return "table";
+    case Kind::SpinUp: return "spin_up";
   }
   return "?";
 }
@@ -174,6 +199,8 @@ std::vector<std::pair<std::string, double>> TimeFunction::parameters() const {
       return {{"t1", a_}};
     case Kind::Triangle:
       return {{"t_peak", a_}, {"t_end", b_}};
+    case Kind::SpinUp:
+      return {{"T_s", a_}};
     default:
       return {};
   }

@@ -1,5 +1,6 @@
 // Scalar load-amplitude functions of time f(t), used by the case file's `loads[].function`
-// (docs/benchmarks.md §1.2 hat, §3.1 triangle). All functions are 0 for t < 0 except `constant`.
+// (docs/benchmarks.md §1.2 hat, §3.1 triangle) and the joints' `angle` (spin_up, docs/benchmarks.md §7.4).
+// All functions are 0 for t < 0 except `constant`.
 //
 // A TimeFunction is a small immutable value; construct it with the named factories, which validate
 // their parameters and throw std::invalid_argument naming the parameter and the accepted range.
@@ -13,7 +14,7 @@ namespace shelldyn {
 
 class TimeFunction {
  public:
-  enum class Kind { Constant, Ramp, Hat, Triangle, Table };
+  enum class Kind { Constant, Ramp, Hat, Triangle, Table, SpinUp };
 
   // f(t) = 1 for all t.
   static TimeFunction constant();
@@ -27,15 +28,20 @@ class TimeFunction {
   // Piecewise linear through (t_k, f_k); constant (f_0 resp. f_last) beyond the ends. At least one
   // point, times strictly increasing, all values finite.
   static TimeFunction table(std::vector<std::pair<double, double>> points);
+  // The spin-up manoeuvre of Kane, Ryan & Banerjee (J. Guidance 10(2), 1987), per unit final rate:
+  // f(t) = (1/T_s)[t²/2 + (T_s/2π)²(cos(2πt/T_s) − 1)] on [0, T_s], then t − T_s/2 (unbounded: a
+  // prescribed_rotation's θ = ω_s f). f, f' and f'' are continuous; f(0) = f'(0) = f''(0) = 0, f'(T_s) = 1,
+  // f''(T_s) = 0. Requires T_s > 0.
+  static TimeFunction spin_up(double T_s);
 
   TimeFunction() : TimeFunction(constant()) {}
 
   double operator()(double t) const;
-  // Right derivative f'(t⁺): every function here is piecewise linear, so this is the slope of the piece that
-  // starts at t (0 where f is constant). Prescribed displacement histories take their initial velocity
-  // from it (docs/theory.md §8.6).
+  // Right derivative f'(t⁺): for the piecewise linear functions the slope of the piece that starts at t (0
+  // where f is constant); for spin_up (smooth) its derivative. Prescribed displacement histories take their
+  // initial velocity from it (docs/theory.md §8.6), prescribed rotations their ∂g/∂t.
   double rate(double t) const;
-  // Time after which f is constant for good (0 if it never changes for t > 0). A prescribed displacement
+  // Time after which f is constant for good (0 if it never changes for t > 0; +inf for spin_up). A prescribed displacement
   // a·f(t) stops moving then, and its supports do no more work (docs/theory.md §8.6).
   double end_of_variation() const;
   // Time after which f is identically 0, or +inf if it never vanishes for good. Loads whose
@@ -53,7 +59,7 @@ class TimeFunction {
  private:
   TimeFunction(Kind kind, double a, double b) : kind_(kind), a_(a), b_(b) {}
   Kind kind_;
-  double a_ = 0.0;  // ramp/hat: t1; triangle: t_peak
+  double a_ = 0.0;  // ramp/hat: t1; triangle: t_peak; spin_up: T_s
   double b_ = 0.0;  // triangle: t_end
   std::vector<std::pair<double, double>> points_;  // table only
 };

@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <string>
 
 using namespace shelldyn;
@@ -92,6 +93,9 @@ const BadCase kBadCases[] = {
      kMinimal + "loads:\n  - {set: all, type: force, direction: [0, 0, 1], amplitude: 1,\n"
                 "     function: {type: table, points: [[0, 0], [1, 1], [1, 2]]}}\n",
      "bad.yaml:8: loads[0].function:", "times must increase"},
+    {"spin_up without a positive T_s",
+     kMinimal + "loads:\n  - {set: all, type: force, direction: [0, 0, 1], amplitude: 1, function: {type: spin_up, T_s: 0}}\n",
+     "bad.yaml:7: loads[0].function.T_s:", "must be > 0"},
     {"time function with a foreign key",
      kMinimal + "loads:\n  - {set: all, type: force, direction: [0, 0, 1], amplitude: 1, function: {type: ramp, t_peak: 1}}\n",
      "bad.yaml:7: loads[0].function.t_peak:", "unknown key"},
@@ -254,6 +258,22 @@ TEST(BenchmarkCases, FlyingPlateMatchesFlpProv) {
   EXPECT_EQ(c.time.num_steps(), 20000);
   EXPECT_TRUE(c.boundary_conditions.empty());
   EXPECT_EQ(c.monitors.size(), 6u);
+}
+
+TEST(BenchmarkCases, SpinUpDrivesTheHubByKaneRyanBanerjee) {
+  // docs/benchmarks.md §7.4: θ(t) = ω_s f(t), ω_s = 6 rad/s, T_s = 15 s; f(T_s) = T_s/2, f' = 1 after T_s.
+  const CaseSpec c = load_case(case_path("spin-up.yaml"));
+  ASSERT_EQ(c.joints.size(), 2u);
+  const JointSpec& drive = c.joints[1];
+  EXPECT_EQ(drive.type, "prescribed_rotation");
+  EXPECT_EQ(drive.angle.kind(), TimeFunction::Kind::SpinUp);
+  EXPECT_EQ(drive.amplitude, 6.0);
+  EXPECT_EQ(drive.axis, Eigen::Vector3d(0, 1, 0));
+  EXPECT_NEAR(drive.amplitude * drive.angle(15.0), 45.0, 1e-12);
+  EXPECT_DOUBLE_EQ(drive.amplitude * drive.angle.rate(16.0), 6.0);
+  // The strip's beam properties: rho A = 1.2 kg/m, EI = E b h³/12 = 14000 N m².
+  EXPECT_NEAR(c.material.rho * c.material.thickness * 0.1, 1.2, 1e-12);
+  EXPECT_NEAR(c.material.E * 0.1 * std::pow(c.material.thickness, 3) / 12.0, 14000.0, 1e-6);
 }
 
 TEST(BenchmarkCases, CylindricalPanelMatchesCypProv) {

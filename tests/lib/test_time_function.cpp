@@ -92,3 +92,34 @@ TEST(TimeFunction, DescribeNamesKindAndParameters) {
   EXPECT_EQ(TimeFunction::triangle(1, 2).describe(), "triangle(t_peak=1, t_end=2)");
   EXPECT_EQ(TimeFunction().describe(), "constant");
 }
+
+// Spin-up of Kane, Ryan & Banerjee (1987): θ/ω_s = (1/T)[t²/2 + (T/2π)²(cos(2πt/T) − 1)] on [0, T], t − T/2 after.
+TEST(TimeFunction, SpinUpMatchesKaneRyanBanerjee) {
+  const double T = 15.0, pi = 3.14159265358979323846;
+  const TimeFunction f = TimeFunction::spin_up(T);
+  const auto theta = [&](double t) {
+    return t <= T ? (t * t / 2.0 + std::pow(T / (2 * pi), 2) * (std::cos(2 * pi * t / T) - 1.0)) / T : t - T / 2;
+  };
+  const auto theta_dot = [&](double t) { return t <= T ? (t - T / (2 * pi) * std::sin(2 * pi * t / T)) / T : 1.0; };
+  const auto theta_ddot = [&](double t) { return t <= T ? (1.0 - std::cos(2 * pi * t / T)) / T : 0.0; };
+  EXPECT_EQ(f(-1.0), 0.0);
+  EXPECT_EQ(f(0.0), 0.0);
+  EXPECT_EQ(f.rate(0.0), 0.0);
+  EXPECT_NEAR(f(T), T / 2, 1e-14 * T);
+  EXPECT_NEAR(f.rate(T), 1.0, 1e-14);
+  EXPECT_DOUBLE_EQ(f(25.0), 25.0 - T / 2);
+  EXPECT_EQ(f.rate(25.0), 1.0);
+  const double h = 1e-4;
+  for (double t : {0.3, 1.0, 4.0, 7.5, 11.0, 14.9, 15.0, 15.1, 20.0}) {
+    EXPECT_NEAR(f(t), theta(t), 1e-13 * (1 + theta(t))) << "t = " << t;
+    EXPECT_NEAR(f.rate(t), theta_dot(t), 1e-14) << "t = " << t;
+    // Central differences: f' from f and f'' from f' (C² across T, so also at t = T).
+    EXPECT_NEAR((f(t + h) - f(t - h)) / (2 * h), f.rate(t), 1e-8) << "t = " << t;
+    EXPECT_NEAR((f.rate(t + h) - f.rate(t - h)) / (2 * h), theta_ddot(t), 1e-7) << "t = " << t;
+  }
+  EXPECT_TRUE(std::isinf(f.end_of_variation()));
+  EXPECT_TRUE(std::isinf(f.end_of_support()));
+  EXPECT_EQ(f.describe(), "spin_up(T_s=15)");
+  EXPECT_THROW(TimeFunction::spin_up(0.0), std::invalid_argument);
+  EXPECT_THROW(TimeFunction::spin_up(-2.0), std::invalid_argument);
+}
