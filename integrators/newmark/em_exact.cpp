@@ -178,6 +178,8 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
     c.scalars["diag_rigid_guards"] = static_cast<double>(diag_.rigid_guards);
     c.scalars["diag_residual_work"] = diag_.residual_work;
     c.scalars["diag_unevaluated_steps"] = static_cast<double>(diag_.unevaluated_steps);
+    c.scalars["diag_metric_switches"] = static_cast<double>(diag_.metric_switches);
+    c.scalars["director_weight"] = director_weight_;  // the correction's metric in use (step_with_cuts)
     c.scalars["renew_steps"] = static_cast<double>(renew_steps_);  // the renewal rule's count (theory §5.5)
     c.scalars["renew_iterations"] = static_cast<double>(renew_iterations_);
     // certify = floor: the floors of the recent steps (the next step's acceptance depends on them).
@@ -211,6 +213,8 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
     diag_.rigid_guards = static_cast<long>(c.scalar("diag_rigid_guards"));
     diag_.residual_work = c.scalars.count("diag_residual_work") ? c.scalar("diag_residual_work") : 0.0;
     diag_.unevaluated_steps = c.scalars.count("diag_unevaluated_steps") ? static_cast<long>(c.scalar("diag_unevaluated_steps")) : 0;
+    diag_.metric_switches = c.scalars.count("diag_metric_switches") ? static_cast<long>(c.scalar("diag_metric_switches")) : 0;
+    director_weight_ = c.scalars.count("director_weight") ? c.scalar("director_weight") : 0.0;
     renew_steps_ = c.scalars.count("renew_steps") ? static_cast<long>(c.scalar("renew_steps")) : 0;
     renew_iterations_ = c.scalars.count("renew_iterations") ? static_cast<long>(c.scalar("renew_iterations")) : 0;
     if (c.scalars.count("energy0")) energy0_ = c.scalar("energy0");
@@ -261,6 +265,7 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
                                               : "predicted");
     newton_ = std::make_unique<NewtonSolver>(sys.pattern(), nopt_);
     full_newton_.reset();
+    director_weight_ = 0.0;  // the system's metric (step_with_cuts may switch it)
     M_ = SparseMatrix{sys.pattern(), std::vector<double>(static_cast<size_t>(sys.pattern()->nnz()), 0.0)};
     K_ = M_;
     for (Eigen::VectorXd* v : {&un_, &umid_, &fint_, &r_, &last_u_}) v->setZero(n);
@@ -331,6 +336,19 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
     if (nopt_.modified) {
       if (step(s, h, rep, &why, true)) return;
       ++rep.rejected_steps;
+    }
+    // Then in the other metric of the correction (docs/theory/newton-iteration.md §4): the weighted one w = h ℓ_e
+    // has a higher round-off floor on stiff bodies, the unweighted w = 1 stalls on thin plates (theory §3). A
+    // step that succeeds only in the other metric makes it the one in use for the following steps. Unconstrained
+    // steps only; each failed attempt counts as a rejected step.
+    if (correction_ && model_->num_constraints() == 0 && model_->num_rigid_bodies() == 0) {
+      director_weight_ = director_weight_ == 0.0 ? 1.0 : 0.0;
+      if (step(s, h, rep, &why)) {
+        ++diag_.metric_switches;
+        return;
+      }
+      ++rep.rejected_steps;
+      director_weight_ = director_weight_ == 0.0 ? 1.0 : 0.0;
     }
     if (depth >= max_cuts_) {
       // One line: where, why (the last attempt's), and the setting that would help (step()).
@@ -432,7 +450,7 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
       const Eigen::Map<const Eigen::VectorXd> u(up, n);
       kinematics(u, charts, h, tmid);
       sys.exact_internal(un_, u, charts, Un_, correction_, xi_, xi_ > 0.0 ? &k0_ : nullptr, fint_.data(), nullptr,
-                         nullptr, &finfo, &pmid_);  // p_mid from kinematics() just above
+                         nullptr, &finfo, &pmid_, director_weight_);  // p_mid from kinematics() just above
       Eigen::Map<Eigen::VectorXd> r(rp, n);
       double scale = 0.0;
       for (int i = 0; i < nn_; ++i) {
@@ -641,7 +659,8 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
     kinematics(u, charts, h, tmid);
     if (xi_ > 0.0) {
       ExactEnergySystem::ExactForceInfo fi;
-      sys.exact_internal(un_, u, charts, Un_, correction_, xi_, &k0_, fint_.data(), nullptr, nullptr, &fi, &pmid_);
+      sys.exact_internal(un_, u, charts, Un_, correction_, xi_, &k0_, fint_.data(), nullptr, nullptr, &fi, &pmid_,
+                         director_weight_);  // the metric the step converged in
       diag_.dissipation += fi.dissipation;
       diag_.min_step_dissipation = std::min(diag_.min_step_dissipation, fi.dissipation);
       diag_.max_beta_z = std::max(diag_.max_beta_z, fi.max_beta_z);
@@ -855,6 +874,7 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
   double refresh_cost_ = 0.0;   // renewal rule (theory §5.5); 0 = off
   double kbar_row_sum_[2] = {0.0, 0.0};  // max_i Σ_j |K̄_ij| of the last K̄ of the modified [0] and full [1] solver
   std::string hint_;  // the setting that would help the last failed step (step_with_cuts' message)
+  double director_weight_ = 0.0;  // the correction's metric in use (exact_internal): 0 = the system's w, or 1
   long renew_steps_ = 0;        // steps since the last refresh of K̄
   long renew_iterations_ = 0;   // their iterations
   static constexpr long kFloorSteps = 16;

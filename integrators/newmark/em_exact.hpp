@@ -64,6 +64,9 @@ class EmExactDiagnostics {
     // counted instead.
     double residual_work = 0.0;
     long unevaluated_steps = 0;
+    // Steps accepted only after a retry in the other metric of the correction (w = 1 or the system's), which then
+    // stays in use (docs/theory/newton-iteration.md §4); their failed attempts count in StepReport::rejected_steps.
+    long metric_switches = 0;
   };
   virtual const Data& diagnostics() const = 0;
 };

@@ -60,12 +60,15 @@ class ExactEnergySystem : public SemiDiscreteSystem {
   // corrected so that it does no work on rigid motions and Δuᵀ F* = U_e(u_np1) − U_n[e]; `correct` = false skips
   // the correction. xi > 0 adds the dissipative force ξ G_e Δu (k0 = (*k0)[e]). K (optional): the symmetric
   // tangent with respect to u_mid. U_np1 (optional): element energies at u_np1. p_mid (optional, 3 per node):
-  // the nodal midpoint directors if the caller has them. Returns V(u_np1).
+  // the nodal midpoint directors if the caller has them. director_weight: the director weight w of the
+  // correction's metric W = diag(1 on d, w on q) (docs/theory/exact-energy-momentum.md §3); 0 = the system's own
+  // choice (the Model: w = h ℓ_e per element), > 0 = this w for every element (em-exact retries a failed step with
+  // w = 1, docs/theory/newton-iteration.md §4). Any w keeps both balances exact. Returns V(u_np1).
   virtual double exact_internal(const Eigen::VectorXd& u_n, const Eigen::VectorXd& u_np1,
                                 const std::vector<DirectorChart>& charts, const std::vector<double>& U_n, bool correct,
                                 double xi, const std::vector<ElementStiffness>* k0, double* F, SparseMatrix* K,
                                 std::vector<double>* U_np1, ExactForceInfo* info,
-                                const Eigen::VectorXd* p_mid = nullptr) const = 0;
+                                const Eigen::VectorXd* p_mid = nullptr, double director_weight = 0.0) const = 0;
   // Dead loads at time t in embedded form: translational forces Fd and director loads g_i = m_i × p_mid,i
   // (3 per node each, overwritten); p_mid holds one 3-vector per node.
   virtual void embedded_external(double t, const Eigen::VectorXd& p_mid, Eigen::VectorXd& Fd, Eigen::VectorXd& g) const = 0;

@@ -658,7 +658,10 @@ CR9Shell::Mat45 Model::reference_local_stiffness(int e) const {
 double Model::exact_internal(const Eigen::VectorXd& u_n, const Eigen::VectorXd& u_np1,
                              const std::vector<DirectorChart>& charts, const std::vector<double>& U_n, bool correct,
                              double xi, const std::vector<CR9Shell::Mat45>* k0, double* F, SparseMatrix* K,
-                             std::vector<double>* U_np1, ExactForceInfo* info, const Eigen::VectorXd* p_mid) const {
+                             std::vector<double>* U_np1, ExactForceInfo* info, const Eigen::VectorXd* p_mid,
+                             double director_weight) const {
+  if (!(director_weight >= 0.0) || !std::isfinite(director_weight))
+    throw std::invalid_argument("Model::exact_internal: director_weight must be finite and >= 0 (0: w = h l_e)");
   if (U_n.size() != elements_.size()) throw std::invalid_argument("Model::exact_internal: U_n needs one entry per element");
   if (p_mid && p_mid->size() != 3 * static_cast<Index>(mesh_.num_nodes()))
     throw std::invalid_argument("Model::exact_internal: p_mid needs 3 entries per node");
@@ -700,13 +703,16 @@ double Model::exact_internal(const Eigen::VectorXd& u_n, const Eigen::VectorXd& 
     if (correct) {  // theory §3: R F* = 0, Δuᵀ F* = ΔU
       const double fmax = fe.cwiseAbs().maxCoeff();
       // The correction's direction in the metric W = diag(1 on d, w on q), w = h ℓ_e (theory §3): ℓ_e = the reference
-      // element's largest node distance / √2 (its side for a square).
-      double diag2 = 0.0;
-      const auto& en = mesh_.elements[static_cast<size_t>(e)];
-      for (size_t a = 0; a < 9; ++a)
-        for (size_t b = a + 1; b < 9; ++b)
-          diag2 = std::max(diag2, (mesh_.X[static_cast<size_t>(en[a])] - mesh_.X[static_cast<size_t>(en[b])]).squaredNorm());
-      const double w = material_.thickness * std::sqrt(0.5 * diag2);
+      // element's largest node distance / √2 (its side for a square). A caller's director_weight > 0 replaces it.
+      double w = director_weight;
+      if (w == 0.0) {
+        double diag2 = 0.0;
+        const auto& en = mesh_.elements[static_cast<size_t>(e)];
+        for (size_t a = 0; a < 9; ++a)
+          for (size_t b = a + 1; b < 9; ++b)
+            diag2 = std::max(diag2, (mesh_.X[static_cast<size_t>(en[a])] - mesh_.X[static_cast<size_t>(en[b])]).squaredNorm());
+        w = material_.thickness * std::sqrt(0.5 * diag2);
+      }
       const CorrectionInfo ci = energy_momentum_correction(*R, du, U1 - U_n[static_cast<size_t>(e)], fe, 1e-20, w);
       guard[static_cast<size_t>(e)] = ci.rigid_guard;
       if (fmax > 0.0) beta_z[static_cast<size_t>(e)] = ci.correction_norm / fmax;

@@ -160,7 +160,8 @@ class Model final : public ExactEnergySystem {
   double exact_internal(const Eigen::VectorXd& u_n, const Eigen::VectorXd& u_np1, const std::vector<DirectorChart>& charts,
                         const std::vector<double>& U_n, bool correct, double xi,
                         const std::vector<CR9Shell::Mat45>* k0, double* F, SparseMatrix* K,
-                        std::vector<double>* U_np1, ExactForceInfo* info, const Eigen::VectorXd* p_mid = nullptr) const override;
+                        std::vector<double>* U_np1, ExactForceInfo* info, const Eigen::VectorXd* p_mid = nullptr,
+                        double director_weight = 0.0) const override;
   void embedded_external(double t, const Eigen::VectorXd& p_mid, Eigen::VectorXd& Fd, Eigen::VectorXd& g) const override;
 
   // Current director of node i.

@@ -77,7 +77,8 @@ class RigidSystem final : public ExactEnergySystem {
   ElementStiffness reference_local_stiffness(int) const override { return ElementStiffness::Zero(); }
   double exact_internal(const Eigen::VectorXd&, const Eigen::VectorXd& u1, const std::vector<DirectorChart>& c,
                         const std::vector<double>&, bool, double, const std::vector<ElementStiffness>*, double* F,
-                        SparseMatrix* K, std::vector<double>* U, ExactForceInfo*, const Eigen::VectorXd*) const override {
+                        SparseMatrix* K, std::vector<double>* U, ExactForceInfo*, const Eigen::VectorXd*,
+                        double) const override {
     if (U) U->clear();
     return internal(u1, c, F, K);
   }
