@@ -448,22 +448,8 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
 
     auto residual = [&](const double* up, double* rp) {
       const Eigen::Map<const Eigen::VectorXd> u(up, n);
-      kinematics(u, charts, h, tmid);
-      sys.exact_internal(un_, u, charts, Un_, correction_, xi_, xi_ > 0.0 ? &k0_ : nullptr, fint_.data(), nullptr,
-                         nullptr, &finfo, &pmid_, director_weight_);  // p_mid from kinematics() just above
       Eigen::Map<Eigen::VectorXd> r(rp, n);
-      double scale = 0.0;
-      for (int i = 0; i < nn_; ++i) {
-        const Index k = DofMap::dof(i, 0);
-        const Vec3 Ad = mv_.segment<3>(3 * i), Ap = mw_.segment<3>(3 * i);
-        const Vec3 fd = fd_.segment<3>(3 * i), g = g_.segment<3>(3 * i);
-        // Theory §2 / §4: translational balance, and the director balance projected by A1(p_mid)ᵀ.
-        r.segment<3>(k) = Ad + fint_.segment<3>(k) - fd;
-        const DirectorChart& ch = charts[static_cast<size_t>(i)];
-        r.segment<2>(k + 3) = embedded_A1(Vec3(pmid_.segment<3>(3 * i)), ch).transpose() * (Ap - g) + fint_.segment<2>(k + 3);
-        scale = std::max({scale, Ad.cwiseAbs().maxCoeff(), Ap.cwiseAbs().maxCoeff(), fd.cwiseAbs().maxCoeff(),
-                          g.cwiseAbs().maxCoeff(), fint_.segment<5>(k).cwiseAbs().maxCoeff()});
-      }
+      const double scale = shell_residual(sys, u, charts, h, tmid, finfo, r);
       zero_constrained(sys.dofs(), rp);
       if (!r.allFinite()) throw std::runtime_error("non-finite residual");
       const double rn = r.cwiseAbs().maxCoeff();
@@ -736,21 +722,8 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
     const int nb = sys.num_rigid_bodies();
     BorderedNewton::Callbacks cb;
     cb.residual = [&](const Eigen::VectorXd& u, Eigen::VectorXd& r) {  // step()'s residual, plus the rigid blocks
-      kinematics(u, charts, h, tmid);
-      sys.exact_internal(un_, u, charts, Un_, correction_, xi_, xi_ > 0.0 ? &k0_ : nullptr, fint_.data(), nullptr, nullptr,
-                         &finfo, &pmid_);
       r.setZero(n);
-      double scale = 0.0;
-      for (int i = 0; i < nn_; ++i) {
-        const Index k = DofMap::dof(i, 0);
-        const Vec3 Ad = mv_.segment<3>(3 * i), Ap = mw_.segment<3>(3 * i);
-        const Vec3 fd = fd_.segment<3>(3 * i), g = g_.segment<3>(3 * i);
-        r.segment<3>(k) = Ad + fint_.segment<3>(k) - fd;
-        const DirectorChart& ch = charts[static_cast<size_t>(i)];
-        r.segment<2>(k + 3) = embedded_A1(Vec3(pmid_.segment<3>(3 * i)), ch).transpose() * (Ap - g) + fint_.segment<2>(k + 3);
-        scale = std::max({scale, Ad.cwiseAbs().maxCoeff(), Ap.cwiseAbs().maxCoeff(), fd.cwiseAbs().maxCoeff(),
-                          g.cwiseAbs().maxCoeff(), fint_.segment<5>(k).cwiseAbs().maxCoeff()});
-      }
+      double scale = shell_residual(sys, u, charts, h, tmid, finfo, r);
       if (nb > 0) {
         umid_ = 0.5 * (u + un_);
         sys.external(tmid, umid_, charts, fext_rb.data());  // dead loads (gravity) on the bodies at t_mid
@@ -829,6 +802,28 @@ class EmExact final : public Integrator, public EmExactDiagnostics {
     accept_step(s, u, t1, h, charts, rep);
     return true;
   }
+  // The shell nodes' residual at the iterate u (step() and step_constrained()): kinematics(), the corrected element
+  // forces in the metric in use, then per node the translational balance and the director balance projected by
+  // A1(p_mid)ᵀ (theory §2 / §4), written into the nodes' entries of r. Returns the force scale (the denominator of ρ).
+  double shell_residual(ExactEnergySystem& sys, const Eigen::VectorXd& u, const std::vector<DirectorChart>& charts,
+                        double h, double tmid, ExactEnergySystem::ExactForceInfo& finfo, Eigen::Ref<Eigen::VectorXd> r) {
+    kinematics(u, charts, h, tmid);
+    sys.exact_internal(un_, u, charts, Un_, correction_, xi_, xi_ > 0.0 ? &k0_ : nullptr, fint_.data(), nullptr, nullptr,
+                       &finfo, &pmid_, director_weight_);  // p_mid from kinematics() just above
+    double scale = 0.0;
+    for (int i = 0; i < nn_; ++i) {
+      const Index k = DofMap::dof(i, 0);
+      const Vec3 Ad = mv_.segment<3>(3 * i), Ap = mw_.segment<3>(3 * i);
+      const Vec3 fd = fd_.segment<3>(3 * i), g = g_.segment<3>(3 * i);
+      r.segment<3>(k) = Ad + fint_.segment<3>(k) - fd;
+      const DirectorChart& ch = charts[static_cast<size_t>(i)];
+      r.segment<2>(k + 3) = embedded_A1(Vec3(pmid_.segment<3>(3 * i)), ch).transpose() * (Ap - g) + fint_.segment<2>(k + 3);
+      scale = std::max({scale, Ad.cwiseAbs().maxCoeff(), Ap.cwiseAbs().maxCoeff(), fd.cwiseAbs().maxCoeff(),
+                        g.cwiseAbs().maxCoeff(), fint_.segment<5>(k).cwiseAbs().maxCoeff()});
+    }
+    return scale;
+  }
+
   // The accepted step's end state of the shell nodes (step() and step_constrained()): v, w from the trapezoidal
   // relations; q̇ and q̈ entries hold the chart's minor components of w and Δw/Δt (for output only: the scheme's state
   // is (d, p, v, w)); a_d = Δv/Δt.
