@@ -294,19 +294,7 @@ class NewmarkFamily final : public Integrator {
       const Eigen::Map<const Eigen::VectorXd> uu(u, n);
       midpoint_state(u);
       sys.inertia_force(umid_, vmid_, amid_, charts, fm_.data());  // M_mid ü_{n+1−α_m} + F_m,mid
-      switch (scheme_) {
-        case Scheme::EmGalpha:  // §6.3 strain-averaged internal force
-          sys.algorithmic_internal(un_, uu, charts, af, xi_, fint_.data(), nullptr);
-          break;
-        case Scheme::Midpoint:
-          sys.internal(umid_, charts, fint_.data(), nullptr);
-          break;
-        case Scheme::Galpha:
-        case Scheme::Newmark:
-          sys.internal(uu, charts, fint_.data(), nullptr);
-          fint_ = (1 - af) * fint_ + af * fint_n_;
-          break;
-      }
+      scheme_internal_force(sys, uu, charts, af);
       external_force(u);
       Eigen::Map<Eigen::VectorXd> rr(r, n);
       rr = fm_ + fint_ - fext_;  // = −P̄ (§6.4)
@@ -460,15 +448,7 @@ class NewmarkFamily final : public Integrator {
     cb.residual = [&](const Eigen::VectorXd& uu, Eigen::VectorXd& r) {  // as step()'s residual
       midpoint_state(uu);
       sys.inertia_force(umid_, vmid_, amid_, charts, fm_.data());
-      switch (scheme_) {
-        case Scheme::EmGalpha: sys.algorithmic_internal(un_, uu, charts, af, xi_, fint_.data(), nullptr); break;
-        case Scheme::Midpoint: sys.internal(umid_, charts, fint_.data(), nullptr); break;
-        case Scheme::Galpha:
-        case Scheme::Newmark:
-          sys.internal(uu, charts, fint_.data(), nullptr);
-          fint_ = (1 - af) * fint_ + af * fint_n_;
-          break;
-      }
+      scheme_internal_force(sys, uu, charts, af);
       external_force(uu);
       r = fm_ + fint_ - fext_;
       zero_constrained(sys.dofs(), r.data());
@@ -553,6 +533,26 @@ class NewmarkFamily final : public Integrator {
 
   Scheme scheme_;
   std::string name_;
+  // fint_ = the scheme's internal force at the iterate u_{n+1} = uu, umid_ already set: strain-averaged (em-galpha,
+  // §6.3), at the midpoint (midpoint), or (1−α_f) F(u_{n+1}) + α_f F(u_n) (galpha, newmark).
+  template <class V>
+  void scheme_internal_force(const SemiDiscreteSystem& sys, const V& uu, const std::vector<DirectorChart>& charts,
+                             double af) {
+    switch (scheme_) {
+      case Scheme::EmGalpha:
+        sys.algorithmic_internal(un_, uu, charts, af, xi_, fint_.data(), nullptr);
+        break;
+      case Scheme::Midpoint:
+        sys.internal(umid_, charts, fint_.data(), nullptr);
+        break;
+      case Scheme::Galpha:
+      case Scheme::Newmark:
+        sys.internal(uu, charts, fint_.data(), nullptr);
+        fint_ = (1 - af) * fint_ + af * fint_n_;
+        break;
+    }
+  }
+
   // K_ = the scheme's stiffness at the iterate u_{n+1} = uu (§6.4), umid_ already set: the strain-averaged tangent
   // (em-galpha), the midpoint tangent (midpoint) or the end-point tangent (galpha, newmark), load stiffness added.
   // (V: the Eigen vector or map the caller holds the iterate in, passed on as it is.)
