@@ -85,7 +85,12 @@ const Eigen::VectorXd& Checkpoint::vector(const std::string& key) const {
 
 void check_checkpoint_origin(const Checkpoint& c, const std::string& path, bool allow_changed_case,
                              bool allow_other_version, std::ostream* note) {
-  if (!c.made_by.empty() && c.made_by != shelldyn_version()) {
+  if (c.made_by.empty()) {  // format 1: no checksum, no version
+    if (!allow_other_version)
+      throw std::runtime_error(path + ": written by a shelldyn whose checkpoints carry no checksum, so its integrity cannot "
+                               "be checked; rerun from the start, or add --allow-other-version to continue anyway");
+    if (note) *note << "note: " << path << ": a checkpoint without checksum (older shelldyn), continued unchecked" << std::endl;
+  } else if (c.made_by != shelldyn_version()) {
     if (!allow_other_version)
       throw std::runtime_error(path + ": written by shelldyn " + c.made_by + ", this is " + shelldyn_version() +
                                "; resume with that version, or add --allow-other-version (the continuation may then "

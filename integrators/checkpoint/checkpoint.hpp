@@ -54,7 +54,8 @@ Checkpoint read_checkpoint(const std::string& path);
 
 // `shelldyn resume`: refuses (std::runtime_error, one line) a checkpoint whose case file was edited since the
 // run started (texts case_source/case_text), unless allow_changed_case, and one written by another shelldyn
-// version, unless allow_other_version; with the flag, or when the case file is gone, one note on `note`.
+// version or one of format 1 (no checksum), unless allow_other_version; with the flag, or when the case file is
+// gone, one note on `note`.
 void check_checkpoint_origin(const Checkpoint& c, const std::string& path, bool allow_changed_case,
                              bool allow_other_version, std::ostream* note);
 

@@ -423,7 +423,7 @@ class NewmarkFamily final : public Integrator {
     vn_ = s.v;
     an_ = s.a;
     const auto& charts = s.charts;
-    const Index n = sys.num_dofs(), m = sys.num_constraints();
+    const Index m = sys.num_constraints();
     const double cu = (1 - af) * ga / (be * h), cv = ((1 - af) * ga - be) / be, ca = (1 - af) * (ga - 2 * be) / (2 * be) * h;
     const double du = (1 - am) / (be * h * h), dv = (1 - am) / (be * h), da = (1 - am - 2 * be) / (2 * be);
     const bool endpoint = (scheme_ == Scheme::Galpha || scheme_ == Scheme::Newmark);

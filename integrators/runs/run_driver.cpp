@@ -4,6 +4,7 @@
 
 #include "integrators/runs/plugin.hpp"
 #include "integrators/sundials/sundials_info.hpp"
+#include "lib/io/append_file.hpp"
 #include "lib/io/history_writer.hpp"
 #include "lib/model/reactions.hpp"
 #include "lib/io/result_folder.hpp"
@@ -368,7 +369,7 @@ RunSummary run_dynamic(Problem& problem, const RunOptions& o) {
   info.discretization.set("loads_end", problem.disc.loads_end);
   std::unique_ptr<HistoryWriter> history;
   std::unique_ptr<PvdWriter> pvd;
-  std::unique_ptr<std::ofstream> bodies_csv;
+  std::unique_ptr<AppendFile> bodies_csv;
   const bool files = !o.out_dir.empty();
   const std::string run_json_path = o.out_dir + "/run.json";
   const std::string checkpoint_path = o.out_dir + "/" + checkpoint_file_name();
@@ -399,8 +400,14 @@ RunSummary run_dynamic(Problem& problem, const RunOptions& o) {
                        : std::make_unique<HistoryWriter>(o.out_dir + "/history.csv", extra, names);
     if (vtu_every > 0) pvd = std::make_unique<PvdWriter>(o.out_dir + "/fields.pvd");
     if (model.num_rigid_bodies() > 0) {  // bodies.csv: the rigid bodies' states per output (docs/manual.md)
-      bodies_csv = std::make_unique<std::ofstream>(o.out_dir + "/bodies.csv", resume ? std::ios::app : std::ios::trunc);
-      if (!resume) *bodies_csv << body_state_header() << "\n";
+      // A resumed run keeps the rows up to its checkpoint (checkpoints without `bodies_bytes` predate the
+      // file's resume position: their rows are kept and appended to, as before).
+      const std::string path = o.out_dir + "/bodies.csv";
+      if (!resume) bodies_csv = std::make_unique<AppendFile>(path, body_state_header());
+      else if (resume->numbers.count("bodies_bytes"))
+        bodies_csv = std::make_unique<AppendFile>(path, body_state_header(), static_cast<long long>(resume->number("bodies_bytes")));
+      else
+        bodies_csv = std::make_unique<AppendFile>(path, body_state_header(), static_cast<long long>(std::filesystem::file_size(path)));
     }
   }
 
@@ -483,6 +490,7 @@ RunSummary run_dynamic(Problem& problem, const RunOptions& o) {
     c.numbers["wall_s"] = elapsed();
     c.numbers["cpu_s"] = cpu_used();
     c.numbers["history_bytes"] = history ? static_cast<double>(history->bytes()) : 0.0;
+    if (bodies_csv) c.numbers["bodies_bytes"] = static_cast<double>(bodies_csv->bytes());
     std::string pvd_files;
     Eigen::VectorXd pvd_times(pvd ? static_cast<Eigen::Index>(pvd->entries().size()) : 0);
     if (pvd)
@@ -525,6 +533,7 @@ RunSummary run_dynamic(Problem& problem, const RunOptions& o) {
     c.numbers["max_steps"] = static_cast<double>(o.max_steps);
     c.numbers["max_wall"] = o.max_wall;
     if (history) history->sync();  // the rows the checkpoint counts are on the disk before it is
+    if (bodies_csv) bodies_csv->sync();
     write_checkpoint(checkpoint_path, c);
     info.checkpoint.set("file", checkpoint_file_name());
     info.checkpoint.set("t", state.t);
@@ -600,7 +609,7 @@ RunSummary run_dynamic(Problem& problem, const RunOptions& o) {
       }
       history->write(row);
     }
-    if (bodies_csv) write_body_states(*bodies_csv, model, state);
+    if (bodies_csv) bodies_csv->append(body_state_rows(model, state));
     if (vtu_now) {
       const std::string file = "fields/" + vtu_step_file_name(out_index);
       write_vtu(o.out_dir + "/" + file, model.mesh(), state_fields(model, state, &R));

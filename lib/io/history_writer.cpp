@@ -1,22 +1,10 @@
 #include "lib/io/history_writer.hpp"
-#include "lib/io/result_folder.hpp"
 
-#include <fcntl.h>
-
-#include <unistd.h>
-
-#include <cerrno>
-#include <cstring>
+#include <cstdio>
 #include <set>
 #include <stdexcept>
 
 namespace shelldyn {
-namespace {
-std::string write_error_reason(int err) {
-  return err == ENOSPC ? std::string("the disk is full (free space and rerun)") : std::string(std::strerror(err));
-}
-}  // namespace
-
 const std::vector<std::string>& history_standard_columns() {
   static const std::vector<std::string> cols = {
       "step", "t",  "dt", "kinetic", "strain", "external_work", "total",           "rel_drift",     "Lx",
@@ -27,67 +15,32 @@ const std::vector<std::string>& history_standard_columns() {
 HistoryWriter::HistoryWriter(const std::string& path, std::vector<std::string> extra_columns,
                              std::vector<std::string> monitor_columns)
     : path_(path), num_extra_(extra_columns.size()), num_monitors_(monitor_columns.size()) {
-  columns_ = history_standard_columns();
-  columns_.insert(columns_.end(), extra_columns.begin(), extra_columns.end());
-  columns_.insert(columns_.end(), monitor_columns.begin(), monitor_columns.end());
-  check_columns();
-  record_output(path);  // the result folder's manifest (lib/io/result_folder.hpp)
-  fd_ = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_APPEND | O_CLOEXEC, 0644);
-  if (fd_ < 0) throw std::runtime_error(path + ": cannot create history file: " + std::strerror(errno));
-  std::string header;
-  for (size_t k = 0; k < columns_.size(); ++k) header += (k ? "," : "") + columns_[k];
-  write_whole(header + "\n");
+  set_columns(extra_columns, monitor_columns);
+  file_ = std::make_unique<AppendFile>(path, header());
 }
 
 HistoryWriter::HistoryWriter(const std::string& path, std::vector<std::string> extra_columns,
                              std::vector<std::string> monitor_columns, long long keep_bytes)
     : path_(path), num_extra_(extra_columns.size()), num_monitors_(monitor_columns.size()) {
+  set_columns(extra_columns, monitor_columns);
+  file_ = std::make_unique<AppendFile>(path, header(), keep_bytes);
+}
+
+std::string HistoryWriter::header() const {
+  std::string h;
+  for (size_t k = 0; k < columns_.size(); ++k) h += (k ? "," : "") + columns_[k];
+  return h;
+}
+
+long long HistoryWriter::bytes() const { return file_->bytes(); }
+
+void HistoryWriter::sync() { file_->sync(); }
+
+void HistoryWriter::set_columns(const std::vector<std::string>& extra, const std::vector<std::string>& monitors) {
   columns_ = history_standard_columns();
-  columns_.insert(columns_.end(), extra_columns.begin(), extra_columns.end());
-  columns_.insert(columns_.end(), monitor_columns.begin(), monitor_columns.end());
+  columns_.insert(columns_.end(), extra.begin(), extra.end());
+  columns_.insert(columns_.end(), monitors.begin(), monitors.end());
   check_columns();
-  std::string header;
-  for (size_t k = 0; k < columns_.size(); ++k) header += (k ? "," : "") + columns_[k];
-  std::FILE* in = std::fopen(path.c_str(), "rb");
-  if (!in) throw std::runtime_error(path + ": cannot reopen the history file to resume: " + std::strerror(errno));
-  std::string first;
-  for (int c; (c = std::fgetc(in)) != EOF && c != '\n';) first += static_cast<char>(c);
-  std::fseek(in, 0, SEEK_END);
-  const long size = std::ftell(in);
-  std::fclose(in);
-  if (first != header) throw std::runtime_error(path + ": header differs from this run's columns; cannot resume");
-  if (size < keep_bytes || keep_bytes < static_cast<long long>(header.size()) + 1)
-    throw std::runtime_error(path + ": shorter than at the checkpoint (" + std::to_string(size) + " < " +
-                             std::to_string(keep_bytes) + " bytes); cannot resume");
-  if (truncate(path.c_str(), static_cast<off_t>(keep_bytes)) != 0)
-    throw std::runtime_error(path + ": cannot cut the rows after the checkpoint: " + std::strerror(errno));
-  fd_ = ::open(path.c_str(), O_WRONLY | O_APPEND | O_CLOEXEC);
-  if (fd_ < 0) throw std::runtime_error(path + ": cannot append to the history file: " + std::strerror(errno));
-  bytes_ = keep_bytes;
-}
-
-long long HistoryWriter::bytes() const { return fd_ >= 0 ? bytes_ : 0; }
-
-void HistoryWriter::sync() {
-  if (fd_ >= 0 && ::fsync(fd_) != 0) throw std::runtime_error(path_ + ": cannot write history.csv: " + write_error_reason(errno));
-}
-
-// One write(2) of the whole text (a short write, e.g. on a full disk, is cut back: no half row stays).
-void HistoryWriter::write_whole(const std::string& text) {
-  if (fd_ < 0) throw std::runtime_error(path_ + ": closed after an earlier write error");
-  ssize_t n = ::write(fd_, text.data(), text.size());
-  while (n < 0 && errno == EINTR) n = ::write(fd_, text.data(), text.size());
-  if (n == static_cast<ssize_t>(text.size())) {
-    bytes_ += n;
-    return;
-  }
-  const int err = n < 0 ? errno : ENOSPC;
-  if (n > 0 && ftruncate(fd_, static_cast<off_t>(bytes_)) != 0) {
-    // if even this fails, the write error below is still the one to report
-  }
-  ::close(fd_);
-  fd_ = -1;
-  throw std::runtime_error(path_ + ": cannot write history.csv: " + write_error_reason(err));
 }
 
 void HistoryWriter::check_columns() {
@@ -99,10 +52,6 @@ void HistoryWriter::check_columns() {
     if (!seen.insert(c).second)
       throw std::invalid_argument("history.csv: column '" + c + "' appears twice (rename the monitor or extra column)");
   }
-}
-
-HistoryWriter::~HistoryWriter() {
-  if (fd_ >= 0) ::close(fd_);
 }
 
 void HistoryWriter::write(const HistoryRow& r) {
@@ -124,7 +73,7 @@ void HistoryWriter::write(const HistoryRow& r) {
   for (double v : r.extra) add(v);
   for (double v : r.monitors) add(v);
   line += '\n';
-  write_whole(line);
+  file_->append(line);
 }
 
 }  // namespace shelldyn

@@ -10,8 +10,11 @@
 
 #include <Eigen/Core>
 #include <cstdio>
+#include <memory>
 #include <string>
 #include <vector>
+
+#include "lib/io/append_file.hpp"
 
 namespace shelldyn {
 
@@ -43,7 +46,6 @@ class HistoryWriter {
   // file is shorter or its header differs from these columns.
   HistoryWriter(const std::string& path, std::vector<std::string> extra_columns,
                 std::vector<std::string> monitor_columns, long long keep_bytes);
-  ~HistoryWriter();
   HistoryWriter(const HistoryWriter&) = delete;
   HistoryWriter& operator=(const HistoryWriter&) = delete;
 
@@ -59,11 +61,11 @@ class HistoryWriter {
   void sync();
 
  private:
+  void set_columns(const std::vector<std::string>& extra, const std::vector<std::string>& monitors);
   void check_columns();
-  void write_whole(const std::string& text);
+  std::string header() const;
   std::string path_;
-  int fd_ = -1;
-  long long bytes_ = 0;
+  std::unique_ptr<AppendFile> file_;  // one write(2) per row (lib/io/append_file.hpp)
   size_t num_extra_ = 0, num_monitors_ = 0;
   std::vector<std::string> columns_;
 };

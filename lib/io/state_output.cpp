@@ -147,27 +147,29 @@ std::string body_state_header() {
   return "t,body,phi_x,phi_y,phi_z,d1_x,d1_y,d1_z,d2_x,d2_y,d2_z,d3_x,d3_y,d3_z,v_x,v_y,v_z,omega_x,omega_y,omega_z";
 }
 
-void write_body_states(std::ostream& out, const Model& model, const State& state) {
+std::string body_state_rows(const Model& model, const State& state) {
   const ModelMultibody* mb = model.multibody();
-  if (!mb) return;
+  std::string out;
+  if (!mb) return out;
   char buf[64];
   auto put = [&](double x) {
     std::snprintf(buf, sizeof buf, ",%.17g", x);
-    out << buf;
+    out += buf;
   };
   for (int b = 0; b < mb->num_bodies(); ++b) {
     const multibody::Vec12 q = mb->body_q(b, state.u);
     const multibody::Vec12 qd = state.v.segment<12>(mb->body_first_dof(b));
     std::snprintf(buf, sizeof buf, "%.17g", state.t);
-    out << buf << "," << mb->body_def(b).name;
+    out += buf;
+    out += "," + mb->body_def(b).name;
     for (int k = 0; k < 12; ++k) put(q[k]);
     for (int k = 0; k < 3; ++k) put(qd[k]);
     Eigen::Vector3d w = Eigen::Vector3d::Zero();
     for (int i = 0; i < 3; ++i) w += 0.5 * Eigen::Vector3d(q.segment<3>(3 + 3 * i)).cross(Eigen::Vector3d(qd.segment<3>(3 + 3 * i)));
     for (int k = 0; k < 3; ++k) put(w[k]);
-    out << "\n";
+    out += "\n";
   }
-  out.flush();
+  return out;
 }
 
 }  // namespace shelldyn

@@ -33,7 +33,8 @@ std::pair<double, double> constraint_drift(const SemiDiscreteSystem& system, con
 // omega_y,omega_z" with the centre of mass φ, the body axes d_i, φ̇ and the spatial angular velocity
 // ω = ½ Σ d_i × ḋ_i (exact for an orthonormal frame with ḋ_i = ω × d_i).
 std::string body_state_header();
-void write_body_states(std::ostream& out, const Model& model, const State& state);
+// One row per body (each ending in "\n"), for one AppendFile::append (lib/io/append_file.hpp).
+std::string body_state_rows(const Model& model, const State& state);
 
 // Creates `dir` and `dir/fields` (and parents). Throws std::runtime_error naming the folder when it
 // cannot be created or written to.

@@ -149,6 +149,13 @@ def main():
         if a != b:
             cols = [header[j] for j in range(len(a)) if a[j] != b[j]]
             fail(f"row {i + 1} (t = {a[1]}) differs in {cols}:\n  ref {a}\n  got {b}")
+    bodies = os.path.join(ref, "bodies.csv")  # runs with rigid bodies: their states per output, row for row
+    if os.path.exists(bodies):
+        with open(bodies) as f_ref, open(os.path.join(cut, "bodies.csv")) as f_cut:
+            b_ref, b_cut = f_ref.read().splitlines(), f_cut.read().splitlines()
+        if b_ref != b_cut:
+            i = next((k for k, (a, b) in enumerate(zip(b_ref, b_cut)) if a != b), min(len(b_ref), len(b_cut)))
+            fail(f"bodies.csv differs from the reference at line {i + 1} ({len(b_cut)} lines, reference {len(b_ref)})")
     if pvd(os.path.join(ref, "fields.pvd")) != pvd(os.path.join(cut, "fields.pvd")):
         fail("fields.pvd differs from the reference")
     print(f"OK: {mode}: history.csv identical to the uninterrupted run in {len(ref_rows)} rows x {len(header) - 1} "

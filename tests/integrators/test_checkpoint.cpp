@@ -12,6 +12,7 @@
 #include "integrators/runs/registry.hpp"
 
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include <cmath>
 #include <cstring>
@@ -20,6 +21,7 @@
 #include <iterator>
 #include <functional>
 #include <limits>
+#include <sstream>
 
 namespace shelldyn {
 namespace {
@@ -100,6 +102,47 @@ TEST(Checkpoint, DamagedOrMissingFilesAreRejectedWithOneLine) {
   fs::resize_file(path, size / 2);
   EXPECT_THROW(read_checkpoint(path), std::runtime_error);
   EXPECT_THROW(read_checkpoint(path + ".absent"), std::runtime_error);
+}
+
+// A checkpoint of format 1 (before checksums) is read, but resuming from it needs --allow-other-version: its
+// integrity cannot be checked (check_checkpoint_origin).
+TEST(Checkpoint, FormatOneWithoutChecksumNeedsAllowOtherVersion) {
+  const std::string path = scratch("format1");
+  Checkpoint c;
+  c.state.t = 0.5;
+  c.state.u = c.state.v = c.state.a = Eigen::VectorXd::LinSpaced(6, 0.0, 1.0);
+  c.integrator = "em-galpha";
+  c.numbers["steps"] = 3;
+  write_checkpoint(path, c);
+  std::string bytes;
+  {
+    std::ifstream in(path, std::ios::binary);
+    bytes.assign((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  }
+  // Unwrap the integrity envelope: format 1 was the body document itself, with its format and version.
+  const nlohmann::json w = nlohmann::json::from_cbor(bytes);
+  const auto& body = w.at("body").get_binary();
+  nlohmann::json j = nlohmann::json::from_cbor(std::vector<std::uint8_t>(body.begin(), body.end()));
+  j["format"] = w.at("format");
+  j["version"] = 1;
+  {
+    const std::vector<std::uint8_t> out = nlohmann::json::to_cbor(j);
+    std::ofstream f(path, std::ios::binary | std::ios::trunc);
+    f.write(reinterpret_cast<const char*>(out.data()), static_cast<std::streamsize>(out.size()));
+  }
+  const Checkpoint r = read_checkpoint(path);
+  EXPECT_TRUE(r.made_by.empty());
+  EXPECT_EQ(r.state.t, 0.5);
+  EXPECT_EQ(r.number("steps"), 3.0);
+  try {
+    check_checkpoint_origin(r, path, false, false, nullptr);
+    ADD_FAILURE() << "a format-1 checkpoint was accepted without --allow-other-version";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("--allow-other-version"), std::string::npos) << e.what();
+  }
+  std::ostringstream note;
+  EXPECT_NO_THROW(check_checkpoint_origin(r, path, false, true, &note));
+  EXPECT_NE(note.str().find("without checksum"), std::string::npos) << note.str();
 }
 
 // Integrity (checkpoint.hpp): every single-bit flip anywhere in a checkpoint is refused as damaged, and a

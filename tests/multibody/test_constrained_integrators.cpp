@@ -283,7 +283,9 @@ TEST(ConstrainedIntegrators, HingedPendulumHasTheClosedFormPeriodAtSecondOrder) 
     EXPECT_LT(e2, 1e-3) << name;
     EXPECT_NEAR(e1 / e2, 4.0, 0.5) << name;
     EXPECT_LT(std::max(g1, g2), 1e-12) << name;
-    if (name == "em-exact" || name == "em-galpha") EXPECT_LT(std::max(dH1, dH2), 1e-10) << name;
+    if (name == "em-exact" || name == "em-galpha") {
+      EXPECT_LT(std::max(dH1, dH2), 1e-10) << name;
+    }
   }
 }
 
