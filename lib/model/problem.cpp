@@ -189,7 +189,12 @@ Problem make_problem(CaseSpec spec) {
     try {
       p.model->check_constraints(p.initial_state());
     } catch (const std::invalid_argument& e) {
-      throw std::runtime_error(p.spec.source + ": joints: " + e.what());
+      // An initial field sets the shell's nodes only (a VTU or CSV holds no rigid-body states).
+      const bool moved = !p.spec.initial_displacement.empty() && p.model->num_rigid_bodies() > 0;
+      throw std::runtime_error(p.spec.source + ": joints: " + e.what() +
+                               (moved ? " (an initial field sets the shell's nodes only; the rigid bodies start as "
+                                        "rigid_bodies defines them)"
+                                      : ""));
     }
   }
   return p;
