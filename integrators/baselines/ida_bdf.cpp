@@ -61,13 +61,27 @@ class IdaBdf final : public SundialsBaseline {
   ~IdaBdf() override { free_ida(); }
   // Holonomic constraints as an index-2 stabilized (GGL) DAE (ida_bdf.hpp, docs/theory/multibody.md §7).
   bool supports_constraints() const override { return true; }
+  // W_presc = ∫ λᵀ ∂g/∂t dt, the work of the driven joints (prescribed_rotation; docs/manual.md §2.13): the power
+  // of the constraint force −Gᵀλ is −λᵀ G v = λᵀ ∂g/∂t on the constraint manifold (G v + ∂g/∂t = 0). It is one
+  // more differential unknown p of the GGL DAE, ṗ = λᵀ ∂g/∂t, after λ and μ (em-galpha's discrete counterpart
+  // is Σ λᵀ τ).
+  double prescribed_work() const override { return presc_; }
+  void save(IntegratorCheckpoint& c) const override {
+    SundialsBaseline::save(c);
+    c.scalars["W_presc"] = presc_;
+  }
+  void restore(SemiDiscreteSystem& system, State& state, const IntegratorCheckpoint& c) override {
+    presc_ = c.scalars.count("W_presc") ? c.scalar("W_presc") : 0.0;  // checkpoints before W_presc: no driver
+    SundialsBaseline::restore(system, state, c);
+  }
 
  private:
   // --- SundialsBaseline hooks ---
   void create_solver(SemiDiscreteSystem& system, const State& state) override {
     free_ida();
     m_ = system.num_constraints();
-    const Index N = fos_->size() + 2 * m_;  // GGL: λ, μ after [q; v; w; d]
+    presc_ = 0.0;  // (restore() sets the checkpoint's value after initialize())
+    const Index N = fos_->size() + (m_ > 0 ? 2 * m_ + 1 : 0);  // GGL: λ, μ, p after [q; v; w; d]
     newton_ = std::make_unique<SecondOrderNewton>(system.pattern(), system.dofs(), linear_solver_);
     fext_.resize(n_);
     cv_.resize(n_);
@@ -76,7 +90,7 @@ class IdaBdf final : public SundialsBaseline {
     id_ = make_serial_vector(N, *ctx_);
     write_y(state);
     N_VConst(1.0, id_.get());
-    for (Index k = fos_->size(); k < N; ++k) data(id_.get())[k] = 0.0;  // λ, μ algebraic
+    for (Index k = fos_->size(); k < fos_->size() + 2 * m_; ++k) data(id_.get())[k] = 0.0;  // λ, μ algebraic
     if (m_ > 0) {  // tolerances of λ, μ (out of the error test, IDASetSuppressAlg; used by Newton's norm)
       atol_all_ = make_serial_vector(N, *ctx_);
       std::copy(data(atol_v_.get()), data(atol_v_.get()) + fos_->size(), data(atol_all_.get()));
@@ -85,7 +99,8 @@ class IdaBdf final : public SundialsBaseline {
       Eigen::VectorXd a0, lambda0;
       ggl_initial(state, a0, lambda0);
       const double a_mult = rtol_ * std::max(1.0, lambda0.size() ? lambda0.cwiseAbs().maxCoeff() : 0.0);
-      for (Index k = fos_->size(); k < N; ++k) data(atol_all_.get())[k] = a_mult;
+      for (Index k = fos_->size(); k < N - 1; ++k) data(atol_all_.get())[k] = a_mult;
+      data(atol_all_.get())[N - 1] = data(atol_v_.get())[fos_->work_index()];  // p: an energy, as w
     }
     J_ = make_placeholder_matrix(*ctx_);
     LS_ = make_callback_linear_solver(*ctx_, {[this] { return ls_setup(); },
@@ -155,6 +170,10 @@ class IdaBdf final : public SundialsBaseline {
         y[k0 + m_ + k] = 0.0;
         yp[k0 + k] = yp[k0 + m_ + k] = 0.0;
       }
+      Eigen::VectorXd gt;  // p and ṗ = λᵀ ∂g/∂t
+      sys_->constraint_time_derivative(s.t, s.u, s.charts, gt);
+      y[k0 + 2 * m_] = presc_;
+      yp[k0 + 2 * m_] = lambda.dot(gt);
     }
     yp[fos_->work_index()] = wdot;
     yp[fos_->damping_index()] = fos_->damping_power(s.v);  // ḋ = vᵀ C v: consistent from the start
@@ -166,6 +185,7 @@ class IdaBdf final : public SundialsBaseline {
     s.t = t_;
     w_ = y[fos_->work_index()];
     d_ = y[fos_->damping_index()];
+    if (m_ > 0) presc_ = y[fos_->size() + 2 * m_];
   }
 
   // --- statistics ---
@@ -252,7 +272,7 @@ class IdaBdf final : public SundialsBaseline {
       const FirstOrderSystem::Powers power = self->fos_->momentum_residual(t, s, self->a_, self->r_);
       for (Index i = 0; i < n; ++i) rv[i] = ypv[i] - yv[n + i];
       std::copy(self->r_.data(), self->r_.data() + n, rv + n);
-      if (self->m_ > 0) self->ggl_residual(t, s, yv, rv);
+      if (self->m_ > 0) self->ggl_residual(t, s, yv, ypv, rv);
       rv[2 * n] = ypv[2 * n] - power.external;
       rv[2 * n + 1] = ypv[2 * n + 1] - power.damping;  // ḋ = vᵀ C v (first_order_system.hpp)
       return 0;
@@ -375,8 +395,8 @@ class IdaBdf final : public SundialsBaseline {
   using SpMat = Eigen::SparseMatrix<double, Eigen::ColMajor, Index>;
   using Trip = Eigen::Triplet<double, Index>;
 
-  // The constraint rows of F: q rows += Gᵀμ, v rows += Gᵀλ, then g and G v + ∂g/∂t.
-  void ggl_residual(double t, const State& s, const double* yv, double* rv) {
+  // The constraint rows of F: q rows += Gᵀμ, v rows += Gᵀλ, then g, G v + ∂g/∂t and ṗ − λᵀ ∂g/∂t.
+  void ggl_residual(double t, const State& s, const double* yv, const double* ypv, double* rv) {
     const Index n = n_, k0 = fos_->size();
     const Eigen::Map<const Eigen::VectorXd> lambda(yv + k0, m_), mu(yv + k0 + m_, m_);
     sys_->constraint_jacobian(t, s.u, s.charts, Gc_);
@@ -393,6 +413,8 @@ class IdaBdf final : public SundialsBaseline {
       rv[k0 + k] = g[k];
       rv[k0 + m_ + k] = gd[k];
     }
+    rv[k0 + 2 * m_] = ypv[k0 + 2 * m_] - lambda.dot(gt);
+    gt_ = gt;  // for the p row of ggl_solve
   }
 
   // The constraint blocks of the Newton matrix at (t, y): G, the Hessian contractions ∂(Gᵀλ)/∂q, ∂(Gᵀμ)/∂q, and
@@ -487,7 +509,9 @@ class IdaBdf final : public SundialsBaseline {
     const double g = 1.0 / cj_fact_;
     x[2 * n] = g * (b[2 * n] + fext_.dot(xv));
     x[2 * n + 1] = g * (b[2 * n + 1] + 2.0 * cv_.dot(xv));
-    return all_finite(x, k0 + 2 * m_) ? SUNLS_SUCCESS : SUNLS_PACKAGE_FAIL_REC;
+    // p row: c_j x_p − (∂g/∂t)ᵀ x_λ = b_p (its dependence on q through ∂g/∂t left out: p feeds nothing back).
+    x[k0 + 2 * m_] = g * (b[k0 + 2 * m_] + (gt_.size() == m_ ? gt_.dot(Eigen::Map<const Eigen::VectorXd>(x + k0, m_)) : 0.0));
+    return all_finite(x, k0 + 2 * m_ + 1) ? SUNLS_SUCCESS : SUNLS_PACKAGE_FAIL_REC;
   }
 
   // Consistent initial values (ida_bdf.hpp): μ = 0, and (v̇, λ) from
@@ -574,6 +598,8 @@ class IdaBdf final : public SundialsBaseline {
   // GGL (m_ > 0)
   Index m_ = 0;
   NVectorPtr atol_all_;
+  Eigen::VectorXd gt_;   // ∂g/∂t at the last residual evaluation (the p row of the Newton matrix)
+  double presc_ = 0.0;   // W_presc = p at the time of y (read_y), or at the restart
   SemiDiscreteSystem::ConstraintMatrix Gc_, Gj_;
   SparseMatrix Hl_, Hm_;
   std::vector<Trip> D_;
