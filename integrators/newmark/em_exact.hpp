@@ -19,7 +19,8 @@
 //   takes the end-point accelerations of Newmark's recursion, em-galpha's predictor, theory §5.9], linear_solver [cholmod], solve_precision [double] (or single: float copy
 //   of the factor, docs/dependencies.md §5.5), res_tol [1e-12], stall_tol [1e-6; a stall below the residual's round-off level
 //   ε max_i Σ_j |K̄_ij| max(1, ‖u_n‖∞) / scale counts as well, docs/theory/newton-iteration.md §3], stall_ratio [0.5],
-//   stall_step [1e-6], max_iters [25], max_cuts [0], hysteresis [1], certify auto|residual|floor|predicted|energy
+//   stall_step [1e-6], max_iters [25; up to 2 max_iters while the residual
+//   still halves every 4 iterations, docs/theory/newton-iteration.md §3.1], max_cuts [0], hysteresis [1], certify auto|residual|floor|predicted|energy
 //   [auto: with modified Newton predicted, or floor when the system prescribes displacements (theory §5.8); else
 //   residual] and floor_margin [1.5] (theory §5.3), predict_factor [1] (certify = predicted: safety factor on
 //   the predicted residual, theory §5.4), cc_tol [1e-14], e_floor [1e-20], step_tol [1e-14] (certify = energy:
