@@ -6,6 +6,8 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "elements/simd.hpp"
+
 namespace shelldyn {
 
 namespace {
@@ -165,20 +167,11 @@ inline DD dd_add(const DD& a, const DD& b) {
   return two_sum(s.hi, s.lo + a.lo + b.lo);
 }
 
-// Nine nodes in vector registers: kLanes doubles per vector (AVX: 4, else SSE2's 2), kNodeVectors vectors.
-#if defined(__AVX__)
-constexpr int kLanes = 4;
-#else
-constexpr int kLanes = 2;
-#endif
+// Nine nodes in vector registers: kNodeVectors vectors of kLanes doubles (elements/simd.hpp).
+using simd::kLanes;
+using simd::splat;
+using VNodes = simd::V;
 constexpr int kNodeVectors = (9 + kLanes - 1) / kLanes;
-typedef double VNodes __attribute__((vector_size(8 * kLanes)));
-
-inline VNodes splat(double a) {
-  VNodes v;
-  for (int k = 0; k < kLanes; ++k) v[k] = a;
-  return v;
-}
 
 // TwoSum lane-wise: returns a + b rounded, *err its rounding error.
 inline VNodes two_sum(VNodes a, VNodes b, VNodes* err) {

@@ -611,7 +611,8 @@ double CR9Shell::local(const Vec45& u, const Charts& charts, Vec45* uL, Vec45* f
 double CR9Shell::internal(const Vec45& u, const Charts& charts, Vec45* F, Mat45* K) const {
   Vec45 w;
   const CorotationalFrame fr = local_increments(u, charts, &w, true, K != nullptr);
-  Vec45 fL = Kbs_ * w;
+  // K_bs w: the dense product with K (the tangent's own path), the compact one of the residual without it.
+  Vec45 fL = K ? Vec45(Kbs_ * w) : kbs_times(w);
   double U = 0.5 * w.dot(fL);
   const Mat39 t = translations(w);
   if (K) {
