@@ -10,6 +10,7 @@
 
 #include "elements/mitc9.hpp"
 #include "elements/shape_functions.hpp"
+#include "elements/simd.hpp"
 
 namespace shelldyn {
 
@@ -345,17 +346,30 @@ CR9Shell::Vec45 CR9Shell::kbs_times(const Vec45& w) const {
     for (Eigen::Index k = 0; k < na; ++k) y(kbs_active_[static_cast<size_t>(k)]) = ya(k);
     return y;
   }
-  // Symmetric packed product: column j of the upper triangle contributes K_ij w_j to y_i (i < j) and
-  // Σ_{i≤j} K_ij w_i to y_j.
-  Vec45 y;
+  // Symmetric packed product (no zero row: doubly curved elements): column j of the upper triangle contributes
+  // K_ij w_j to y_i (i < j) and Σ_{i≤j} K_ij w_i to y_j; one pass over the column's off-diagonal part does both,
+  // kLanes rows at a time (elements/simd.hpp).
+  using simd::kLanes;
+  alignas(32) double y[48] = {}, wp[48] = {};
+  for (int i = 0; i < 45; ++i) wp[i] = w(i);
   const double* col = Kbsp_.data();
   for (int j = 0; j < 45; ++j) {
-    const Eigen::Map<const Eigen::VectorXd> kj(col, j + 1);
-    y(j) = kj.dot(w.head(j + 1));
-    y.head(j) += w(j) * kj.head(j);
+    const double wj = w(j);
+    const simd::V wjv = simd::splat(wj);
+    simd::V dv = simd::splat(0.0);
+    int i = 0;
+    for (; i + kLanes <= j; i += kLanes) {
+      const simd::V k = simd::load(col + i);
+      simd::store(y + i, simd::load(y + i) + k * wjv);
+      dv += k * simd::load(wp + i);
+    }
+    double d = 0.0;
+    for (int l = 0; l < kLanes; ++l) d += dv[l];
+    for (; i < j; ++i) y[i] += col[i] * wj, d += col[i] * wp[i];
+    y[j] += d + col[j] * wj;
     col += j + 1;
   }
-  return y;
+  return Eigen::Map<const Vec45>(y);
 }
 
 CorotationalFrame CR9Shell::local_increments(const Vec45& u, const Charts& charts, Vec45* w, bool derivatives,
@@ -611,8 +625,9 @@ double CR9Shell::local(const Vec45& u, const Charts& charts, Vec45* uL, Vec45* f
 double CR9Shell::internal(const Vec45& u, const Charts& charts, Vec45* F, Mat45* K) const {
   Vec45 w;
   const CorotationalFrame fr = local_increments(u, charts, &w, true, K != nullptr);
-  // K_bs w: the dense product with K (the tangent's own path), the compact one of the residual without it.
-  Vec45 fL = K ? Vec45(Kbs_ * w) : kbs_times(w);
+  // K_bs w: the dense product with K (the tangent's own path) and for an element without zero rows of K_bs (where
+  // it takes fewer instructions than the packed one), else the residual's active block.
+  Vec45 fL = (K || kbs_active_.empty()) ? Vec45(Kbs_ * w) : kbs_times(w);
   double U = 0.5 * w.dot(fL);
   const Mat39 t = translations(w);
   if (K) {
