@@ -74,6 +74,34 @@ TEST(CR9Kernel, TyingMembraneMatchesGaussPointReference) {
   std::printf("worst relative differences to the reference path: F %.1e, K %.1e, U %.1e\n", worst_f, worst_k, worst_u);
 }
 
+// The residual's compact K_bs w (kbs_times(): the active dense block of a flat or singly curved element, the packed
+// symmetric vector pass of a doubly curved one) against the dense 45 × 45 product of the plain overload of
+// algorithmic_internal() (F only: T(u_mid)ᵀ[K_bs (c1 w1 + c0 wn) + membrane]), which shares neither K_bs kernel
+// nor the membrane kernel with the step-state residual. Forces of strained states, 1e-13 relative (observed
+// ~1e-16: the same terms summed in another order).
+TEST(CR9Kernel, ResidualKbsProductMatchesDenseProduct) {
+  std::vector<Geometry> geoms;
+  for (Shape s : {Shape::Flat, Shape::Distorted, Shape::Cylinder}) geoms.push_back(make_geometry(s, Facing::Y));
+  geoms.push_back(sphere_patch());
+  double worst = 0.0;
+  for (const Geometry& g : geoms) {
+    const CR9Shell e(g.X0, g.p0, test_material());
+    for (unsigned seed = 1; seed <= 5; ++seed) {
+      Charts ch;
+      const Vec45 un = random_state(g, 0.05, 0.6, seed, &ch);
+      const Vec45 u1 = un + random_vector(0.01, seed + 70);
+      CR9Shell::StepState sn;
+      e.step_state(un, ch, &sn);
+      Vec45 Fs, Fd;
+      e.algorithmic_internal(sn, un, u1, ch, 0.5, 0.0, &Fs, nullptr);
+      e.algorithmic_internal(un, u1, ch, 0.5, 0.0, &Fd, nullptr);
+      worst = std::max(worst, rel(Fs, Fd));
+      EXPECT_LT(rel(Fs, Fd), 1e-13) << g.name << " seed " << seed;
+    }
+  }
+  std::printf("step-state residual against the dense-K_bs plain overload: worst relative difference %.1e\n", worst);
+}
+
 // The compensated local translations t_i = Rᵀ((X_i − X_O) + (d_i − d_O)) − x_i0 (CorotationalFrame::local_variables
 // with the reference offsets, a compensated dot product per component) against the same expression in binary128
 // (__float128: every product of doubles and every sum here is exact or within 2^-113), with R, X_i − X_O, x_i0
