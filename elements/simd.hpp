@@ -1,6 +1,6 @@
 // Portable short vectors for the element kernels (GCC/Clang vector extensions): kLanes doubles per vector, 4 when
 // the target has AVX (e.g. -march=native, SHELLDYN_NATIVE), else SSE2's 2. Lane-wise IEEE arithmetic; used where
-// GCC does not vectorize plain loops by itself (arrays over the nine nodes, the K_bs block product).
+// GCC does not vectorize plain loops by itself (arrays over the nine nodes, the packed K_bs product).
 #pragma once
 
 #include <cstring>
