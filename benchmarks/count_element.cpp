@@ -2,7 +2,7 @@
 // kernel exactly N times on bench_element's cylindrical element, so that instructions / N is the cost of one
 // call. Run: valgrind --tool=callgrind --toggle-collect='shelldyn::CR9Shell::algorithmic_internal*'
 // build/bin/count_element residual 2000
-// (scripts/element_icount.sh does that for every kernel). Kernels: residual (algorithmic_internal with the step
+// (scripts/element_icount.sh does that for every kernel). A third argument "sphere" runs the patch on a sphere. Kernels: residual (algorithmic_internal with the step
 // state, F only: what one em-galpha residual costs per element), internal_f (internal(), F only), tangent
 // (algorithmic_internal with F and K), step_state.
 #include <Eigen/Geometry>
@@ -19,8 +19,13 @@ using namespace shelldyn;
 
 int main(int argc, char** argv) {
   if (argc < 2 || std::string(argv[1]) == "--help") {
-    std::printf("usage: count_element residual|internal_f|tangent|step_state [N=1000]\n");
+    std::printf("usage: count_element residual|internal_f|tangent|step_state [N=1000] [cylinder|sphere]\n");
     return argc < 2 ? 1 : 0;
+  }
+  const std::string shape = argc > 3 ? argv[3] : "cylinder";
+  if (shape != "cylinder" && shape != "sphere") {
+    std::fprintf(stderr, "count_element: unknown geometry '%s' (cylinder, sphere)\n", shape.c_str());
+    return 1;
   }
   const std::string which = argv[1];
   const long n = argc > 2 ? std::atol(argv[2]) : 1000;
@@ -28,14 +33,20 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "count_element: N = %s must be a positive integer\n", argv[2]);
     return 1;
   }
-  // The element of bench_element.cpp's make_setup() (cylindrical, R = 2, 0.5 rad x 1, deformed).
+  // The element of bench_element.cpp's make_setup() (cylindrical, R = 2, 0.5 rad x 1, deformed), or the same
+  // patch on a sphere of radius 2 (doubly curved: K_bs has no zero rows, as on the pinched hemisphere).
   std::array<Eigen::Vector3d, 9> X0, p0;
   CR9Shell::Charts charts;
   CR9Shell::Vec45 u, u1;
   for (int k = 0; k < 9; ++k) {
-    const double phi = 0.25 * kNodeXi[k];
-    X0[k] = Eigen::Vector3d(2.0 * std::sin(phi), 0.5 * kNodeEta[k], 2.0 * std::cos(phi) - 2.0);
-    p0[k] = Eigen::Vector3d(std::sin(phi), 0.0, std::cos(phi));
+    const double phi = 0.25 * kNodeXi[k], psi = 0.25 * kNodeEta[k];
+    if (shape == "cylinder") {
+      X0[k] = Eigen::Vector3d(2.0 * std::sin(phi), 0.5 * kNodeEta[k], 2.0 * std::cos(phi) - 2.0);
+      p0[k] = Eigen::Vector3d(std::sin(phi), 0.0, std::cos(phi));
+    } else {
+      p0[k] = Eigen::Vector3d(std::tan(phi), std::tan(psi), 1.0).normalized();
+      X0[k] = 2.0 * p0[k] - Eigen::Vector3d(0.0, 0.0, 2.0);
+    }
   }
   std::mt19937 rng(1);
   std::uniform_real_distribution<double> U(-1.0, 1.0);

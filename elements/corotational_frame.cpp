@@ -6,6 +6,8 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "elements/simd.hpp"
+
 namespace shelldyn {
 
 namespace {
@@ -165,6 +167,20 @@ inline DD dd_add(const DD& a, const DD& b) {
   return two_sum(s.hi, s.lo + a.lo + b.lo);
 }
 
+// Nine nodes in vector registers: kNodeVectors vectors of kLanes doubles (elements/simd.hpp).
+using simd::kLanes;
+using simd::splat;
+using VNodes = simd::V;
+constexpr int kNodeVectors = (9 + kLanes - 1) / kLanes;
+
+// TwoSum lane-wise: returns a + b rounded, *err its rounding error.
+inline VNodes two_sum(VNodes a, VNodes b, VNodes* err) {
+  const VNodes s = a + b;
+  const VNodes bb = s - a;
+  *err = (a - (s - bb)) + (b - bb);
+  return s;
+}
+
 }  // namespace
 
 CorotationalFrame::Vec45 CorotationalFrame::local_variables(const std::array<Eigen::Vector3d, 9>& x_local0,
@@ -177,57 +193,77 @@ CorotationalFrame::Vec45 CorotationalFrame::local_variables(const std::array<Eig
     for (int k = 0; k < 4; ++k) acc = dd_add(acc, {disp[k](c), 0.0});
     dO[c] = {0.25 * acc.hi, 0.25 * acc.lo};  // exact scaling by a power of two
   }
-  // The same operations as a node-by-node loop, laid out node-innermost (arrays over the 9 nodes, padded to 10
-  // with a zero node so that every loop is five whole SSE2 packets) so that the compiler runs them on all nodes
-  // at once in vector registers; without FMA the Dekker splits of R's entries and of rel's high parts are formed
-  // once each instead of once per product (the same values: bitwise the node-by-node results).
-  constexpr int n = 10;
-  // rel_i = (X_i - X_O) + (d_i - d_O), exact to double-double.
-  alignas(16) double rh[3][n], rl[3][n];
+  // All nine nodes at once in vector registers: node k is lane k % W of vector k / W (the padding lanes hold zero
+  // nodes). Explicit vector types, because GCC does not vectorize these loops by itself.
+  using V = VNodes;
+  constexpr int nv = kNodeVectors;
+  // rel_i = (X_i - X_O) + (d_i - d_O) = rh + rl: two TwoSums, rl = e1 + e2 - d_O,lo (|rl| ~ ulp(rel); its own
+  // rounding is ~u² |rel|).
+  V rh[3][nv], rl[3][nv];
   for (int c = 0; c < 3; ++c) {
-    alignas(16) double ref[n], d[n];
-    for (int i = 0; i < 9; ++i) ref[i] = rel_ref[i](c), d[i] = disp[i](c);
-    ref[9] = d[9] = 0.0;
-    for (int i = 0; i < n; ++i) {
-      const DD r = dd_add(dd_add({ref[i], 0.0}, {d[i], 0.0}), {-dO[c].hi, -dO[c].lo});
-      rh[c][i] = r.hi;
-      rl[c][i] = r.lo;
+    V ref[nv], d[nv];
+    for (int v = 0; v < nv; ++v) {
+      ref[v] = d[v] = splat(0.0);
+      for (int k = 0; k < kLanes; ++k) {
+        const int i = kLanes * v + k;
+        if (i < 9) ref[v][k] = rel_ref[i](c), d[v][k] = disp[i](c);
+      }
+    }
+    const V oh = splat(-dO[c].hi), ol = splat(dO[c].lo);
+    for (int v = 0; v < nv; ++v) {
+      V e1, e2;
+      const V s1 = two_sum(ref[v], d[v], &e1);
+      rh[c][v] = two_sum(s1, oh, &e2);
+      rl[c][v] = (e1 + e2) - ol;
     }
   }
 #ifndef __FMA__
+  // Without FMA the Dekker splits of R's entries and of rel's high parts are formed once each instead of once
+  // per product.
   constexpr double split = 134217729.0;  // 2^27 + 1 (Dekker)
-  alignas(16) double bh[3][n], bl[3][n];
+  V bh[3][nv], bl[3][nv];
   for (int c = 0; c < 3; ++c)
-    for (int i = 0; i < n; ++i) {
-      const double cb = split * rh[c][i];
-      bh[c][i] = cb - (cb - rh[c][i]);
-      bl[c][i] = rh[c][i] - bh[c][i];
+    for (int v = 0; v < nv; ++v) {
+      const V cb = split * rh[c][v];
+      bh[c][v] = cb - (cb - rh[c][v]);
+      bl[c][v] = rh[c][v] - bh[c][v];
     }
 #endif
+  // t_i,r = -x_i0,r + Σ_c R_cr rel_i,c as a compensated dot product (Ogita, Rump & Oishi's Dot2): the products'
+  // high parts are summed by TwoSum into S, every rounding error (TwoSum's, TwoProduct's, and the products of
+  // the low parts R_cr rl) into E, and t = S + E. The result is as accurate as if computed in twice the working
+  // precision and then rounded: error <= u |t| + O(u²) Σ|terms|.
   Vec45 u;
   for (int r = 0; r < 3; ++r) {
-    alignas(16) double ahi[n], alo[n];
-    for (int i = 0; i < 9; ++i) ahi[i] = -x_local0[i](r);
-    ahi[9] = 0.0;
-    for (int i = 0; i < n; ++i) alo[i] = 0.0;
-    for (int c = 0; c < 3; ++c) {
-      const double a = R_(c, r);
-#ifndef __FMA__
-      const double ca = split * a, ah = ca - (ca - a), al = a - ah;
-#endif
-      for (int i = 0; i < n; ++i) {
-        const double p = a * rh[c][i];
-#ifdef __FMA__
-        const double pe = std::fma(a, rh[c][i], -p);
-#else
-        const double pe = ((ah * bh[c][i] - p) + ah * bl[c][i] + al * bh[c][i]) + al * bl[c][i];  // two_prod's error
-#endif
-        const DD acc = dd_add({ahi[i], alo[i]}, {p, pe + a * rl[c][i]});
-        ahi[i] = acc.hi;
-        alo[i] = acc.lo;
+    V S[nv], E[nv];
+    for (int v = 0; v < nv; ++v) {
+      S[v] = E[v] = splat(0.0);
+      for (int k = 0; k < kLanes; ++k) {
+        const int i = kLanes * v + k;
+        if (i < 9) S[v][k] = -x_local0[i](r);
       }
     }
-    for (int i = 0; i < 9; ++i) u(5 * i + r) = ahi[i] + alo[i];
+    for (int c = 0; c < 3; ++c) {
+      const double a = R_(c, r);
+      const V va = splat(a);
+#ifndef __FMA__
+      const double ca = split * a, ah = ca - (ca - a), al = a - ah;
+      const V vah = splat(ah), val = splat(al);
+#endif
+      for (int v = 0; v < nv; ++v) {
+        const V p = va * rh[c][v];
+#ifdef __FMA__
+        V pe;
+        for (int k = 0; k < kLanes; ++k) pe[k] = std::fma(a, rh[c][v][k], -p[k]);
+#else
+        const V pe = ((vah * bh[c][v] - p) + vah * bl[c][v] + val * bh[c][v]) + val * bl[c][v];  // two_prod's error
+#endif
+        V e;
+        S[v] = two_sum(S[v], p, &e);
+        E[v] += (e + pe) + va * rl[c][v];
+      }
+    }
+    for (int i = 0; i < 9; ++i) u(5 * i + r) = S[i / kLanes][i % kLanes] + E[i / kLanes][i % kLanes];
   }
   for (int i = 0; i < 9; ++i) {
     u(5 * i + 3) = R_.col(0).dot(p_[i]);

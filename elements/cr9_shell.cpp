@@ -10,6 +10,7 @@
 
 #include "elements/mitc9.hpp"
 #include "elements/shape_functions.hpp"
+#include "elements/simd.hpp"
 
 namespace shelldyn {
 
@@ -90,7 +91,7 @@ const Eigen::Matrix<double, 9, 20>& tying_dN() {
   return D;
 }
 
-// D_τ with a zero tenth row (10 × 20): f_tᵀ = D_τ Gᵀ then runs as five whole SSE2 packets per column.
+// D_τ with a zero tenth row (10 × 20, column-major): f_tᵀ = D_τ G runs as five whole SSE2 packets per column.
 const Eigen::Matrix<double, 10, 20>& tying_dN10() {
   static const Eigen::Matrix<double, 10, 20> D = [] {
     Eigen::Matrix<double, 10, 20> d = Eigen::Matrix<double, 10, 20>::Zero();
@@ -104,6 +105,37 @@ const Eigen::Matrix<double, 10, 20>& tying_dN10() {
 const Eigen::Matrix<double, 20, 9>& tying_dNT() {
   static const Eigen::Matrix<double, 20, 9> DT = tying_dN().transpose();
   return DT;
+}
+
+// The MITC9 interpolation weights of the tying strains at the Gauss points g = 3 ig + jg (ξ = x_ig, η = x_jg):
+// family A's point i·3 + j weighs lin_i(ξ) quad_j(η) and quad_j(η) is 1 at j = jg, 0 otherwise (its tying rows
+// η = 0, ±√(3/5) are the Gauss rows); likewise family B's point i·2 + j weighs quad_i(ξ) lin_j(η), nonzero for
+// i = ig only. a[g][i]: family A's points i·3 + jg, b[g][j]: family B's points ig·2 + j, c[g][k]: family C's four.
+// The structure is checked against mitc9_weights(): every other weight must be exactly zero.
+struct GaussTyingWeights {
+  double a[9][2], b[9][2], c[9][4];
+};
+const GaussTyingWeights& mitc9_gauss_weights() {
+  static const GaussTyingWeights W = [] {
+    GaussTyingWeights w{};
+    const auto& gx = gauss3_points();
+    for (int ig = 0; ig < 3; ++ig)
+      for (int jg = 0; jg < 3; ++jg) {
+        const int g = 3 * ig + jg;
+        const Eigen::Matrix<double, 6, 1> wa = mitc9_weights(0, gx[ig], gx[jg]), wb = mitc9_weights(1, gx[ig], gx[jg]),
+                                          wc = mitc9_weights(2, gx[ig], gx[jg]);
+        for (int k = 0; k < 6; ++k) {
+          const bool a_used = k % 3 == jg, b_used = k / 2 == ig;
+          if ((!a_used && wa(k) != 0.0) || (!b_used && wb(k) != 0.0))
+            throw std::logic_error("mitc9_gauss_weights: a MITC9 tying weight expected zero at a Gauss point is not");
+          if (a_used) w.a[g][k / 3] = wa(k);
+          if (b_used) w.b[g][k % 2] = wb(k);
+        }
+        for (int k = 0; k < 4; ++k) w.c[g][k] = wc(k);
+      }
+    return w;
+  }();
+  return W;
 }
 
 std::string node_name(int i) { return "node " + std::to_string(i + 1) + " (index " + std::to_string(i) + ")"; }
@@ -176,9 +208,9 @@ CR9Shell::CR9Shell(const std::array<Eigen::Vector3d, 9>& X0, const std::array<Ei
     for (int k = 0; k < fam.count; ++k) tying[f][k] = covariant(fam.xi[k], fam.eta[k], xl0_, r0, L);
   }
   tying_ = opt_.mitc && opt_.tying_membrane;
-  At_.setZero();
-  for (int k = 0; k < 6; ++k) Xt_.col(k) = tying[0][k].Xa[0], Xt_.col(6 + k) = tying[1][k].Xa[1];
-  for (int k = 0; k < 4; ++k) Xt_.col(12 + k) = tying[2][k].Xa[0], Xt_.col(16 + k) = tying[2][k].Xa[1];
+  for (int k = 0; k < 6; ++k) XtT_.row(k) = tying[0][k].Xa[0].transpose(), XtT_.row(6 + k) = tying[1][k].Xa[1].transpose();
+  for (int k = 0; k < 4; ++k)
+    XtT_.row(12 + k) = tying[2][k].Xa[0].transpose(), XtT_.row(16 + k) = tying[2][k].Xa[1].transpose();
 
   const double h = mat.thickness;
   const double G = mat.E / (2.0 * (1.0 + mat.nu));
@@ -244,15 +276,7 @@ CR9Shell::CR9Shell(const std::array<Eigen::Vector3d, 9>& X0, const std::array<Ei
           2.0 * j(0, 0) * j(1, 0), 2.0 * j(0, 1) * j(1, 1), 2.0 * (j(0, 0) * j(1, 1) + j(0, 1) * j(1, 0));
       GaussPoint& gp = gp_[3 * ig + jg];
       gp.dA = dA;
-      if (opt_.mitc) {  // ε_c = Σ_ab Tm(c, ab) Σ_k w_ab,k ê_ab,k (§4.4–4.5), the tying-point form's A
-        const int g = 3 * ig + jg;
-        const Eigen::Matrix<double, 6, 1> w0 = mitc9_weights(0, xi, eta), w1 = mitc9_weights(1, xi, eta),
-                                          w2 = mitc9_weights(2, xi, eta);
-        for (int c = 0; c < 3; ++c) {
-          for (int k = 0; k < 6; ++k) At_(3 * g + c, k) = Tm(c, 0) * w0(k), At_(3 * g + c, 6 + k) = Tm(c, 1) * w1(k);
-          for (int k = 0; k < 4; ++k) At_(3 * g + c, 12 + k) = Tm(c, 2) * w2(k);
-        }
-      }
+      Tm_[static_cast<size_t>(3 * ig + jg)] = Tm;  // the tying-point form's ε = Tm ẽ (§4.4–4.5)
       for (int c = 0; c < 3; ++c) {
         gp.Lm.row(c) = Tm(c, 0) * eL[0] + Tm(c, 1) * eL[1] + Tm(c, 2) * eL[2];
         gp.Hm[c] = Tm(c, 0) * eH[0] + Tm(c, 1) * eH[1] + Tm(c, 2) * eH[2];
@@ -278,7 +302,6 @@ CR9Shell::CR9Shell(const std::array<Eigen::Vector3d, 9>& X0, const std::array<Ei
         for (int i = 0; i <= j; ++i) Hp_(i + j * (j + 1) / 2, 3 * g + c) = gp.Hm[static_cast<size_t>(c)](i, j);
       dAall_(3 * g + c) = gp.dA;
     }
-  AtT_ = At_.transpose();
   for (int j = 0; j < 45; ++j)
     for (int i = 0; i <= j; ++i) Kbsp_(i + j * (j + 1) / 2) = Kbs_(i, j);
   for (int j = 0; j < 27; ++j)
@@ -323,17 +346,30 @@ CR9Shell::Vec45 CR9Shell::kbs_times(const Vec45& w) const {
     for (Eigen::Index k = 0; k < na; ++k) y(kbs_active_[static_cast<size_t>(k)]) = ya(k);
     return y;
   }
-  // Symmetric packed product: column j of the upper triangle contributes K_ij w_j to y_i (i < j) and
-  // Σ_{i≤j} K_ij w_i to y_j.
-  Vec45 y;
+  // Symmetric packed product (no zero row: doubly curved elements): column j of the upper triangle contributes
+  // K_ij w_j to y_i (i < j) and Σ_{i≤j} K_ij w_i to y_j; one pass over the column's off-diagonal part does both,
+  // kLanes rows at a time (elements/simd.hpp).
+  using simd::kLanes;
+  alignas(32) double y[48] = {}, wp[48] = {};
+  for (int i = 0; i < 45; ++i) wp[i] = w(i);
   const double* col = Kbsp_.data();
   for (int j = 0; j < 45; ++j) {
-    const Eigen::Map<const Eigen::VectorXd> kj(col, j + 1);
-    y(j) = kj.dot(w.head(j + 1));
-    y.head(j) += w(j) * kj.head(j);
+    const double wj = w(j);
+    const simd::V wjv = simd::splat(wj);
+    simd::V dv = simd::splat(0.0);
+    int i = 0;
+    for (; i + kLanes <= j; i += kLanes) {
+      const simd::V k = simd::load(col + i);
+      simd::store(y + i, simd::load(y + i) + k * wjv);
+      dv += k * simd::load(wp + i);
+    }
+    double d = 0.0;
+    for (int l = 0; l < kLanes; ++l) d += dv[l];
+    for (; i < j; ++i) y[i] += col[i] * wj, d += col[i] * wp[i];
+    y[j] += d + col[j] * wj;
     col += j + 1;
   }
-  return y;
+  return Eigen::Map<const Vec45>(y);
 }
 
 CorotationalFrame CR9Shell::local_increments(const Vec45& u, const Charts& charts, Vec45* w, bool derivatives,
@@ -380,25 +416,92 @@ CorotationalFrame CR9Shell::frame(const Vec45& u, const Charts& charts) const {
   return local_increments(u, charts, nullptr);
 }
 
-Eigen::Matrix<double, 3, 20> CR9Shell::tying_tau(const Mat39& t) const {
-  // τ_j = Σ_i N_i,a(point j) t_i, as τᵀ = D_τᵀ tᵀ: column-major 20-long columns, which Eigen's coefficient-based
-  // product evaluates packet-wise.
-  const Eigen::Matrix<double, 20, 3> tauT = tying_dNT().lazyProduct(t.transpose());
-  return tauT.transpose();
+CR9Shell::TauT CR9Shell::tying_tau(const Mat39& t) const {
+  // τ(j, c) = Σ_i N_i,a(point j) t_i,c: per component a 20-long accumulator (ten SSE2 packets, kept in registers)
+  // updated by the nine columns of D_τᵀ in node order.
+  const double* D = tying_dNT().data();
+  TauT tau;
+  for (int c = 0; c < 3; ++c) {
+    alignas(16) double acc[20];
+    const double t0 = t(c, 0);
+    for (int k = 0; k < 20; ++k) acc[k] = D[k] * t0;
+#pragma GCC unroll 8
+    for (int i = 1; i < 9; ++i) {
+      const double ti = t(c, i);
+      const double* Di = D + 20 * i;
+      for (int k = 0; k < 20; ++k) acc[k] += Di[k] * ti;
+    }
+    for (int k = 0; k < 20; ++k) tau(k, c) = acc[k];
+  }
+  return tau;
+}
+
+Eigen::Matrix<double, 27, 1> CR9Shell::tying_strains(const TauT& tau) const {
+  // §4.4 tying-point strains ê_ab = ½(X_a·τ_b + X_b·τ_a + τ_a·τ_b): families A, B (rows 0–11) ê = X·τ + ½|τ|²,
+  // family C (rows 12–15 ξ, 16–19 η) ê = ½(X_ξ·τ_η + X_η·τ_ξ + τ_ξ·τ_η).
+  alignas(16) double eh[16];
+  const double *X0 = XtT_.col(0).data(), *X1 = XtT_.col(1).data(), *X2 = XtT_.col(2).data();
+  const double *u0 = tau.col(0).data(), *u1 = tau.col(1).data(), *u2 = tau.col(2).data();
+  for (int k = 0; k < 12; ++k)
+    eh[k] = (X0[k] * u0[k] + X1[k] * u1[k] + X2[k] * u2[k]) + 0.5 * (u0[k] * u0[k] + u1[k] * u1[k] + u2[k] * u2[k]);
+  for (int k = 12; k < 16; ++k)
+    eh[k] = 0.5 * ((X0[k] * u0[k + 4] + X1[k] * u1[k + 4] + X2[k] * u2[k + 4]) +
+                   (X0[k + 4] * u0[k] + X1[k + 4] * u1[k] + X2[k + 4] * u2[k]) +
+                   (u0[k] * u0[k + 4] + u1[k] * u1[k + 4] + u2[k] * u2[k + 4]));
+  // ε = Tm ẽ per Gauss point, ẽ = (family A's 2, family B's 2, family C's 4 weighted tying strains).
+  const GaussTyingWeights& W = mitc9_gauss_weights();
+  Eigen::Matrix<double, 27, 1> e;
+  for (int ig = 0; ig < 3; ++ig)
+    for (int jg = 0; jg < 3; ++jg) {
+      const int g = 3 * ig + jg;
+      const double ea = W.a[g][0] * eh[jg] + W.a[g][1] * eh[3 + jg];
+      const double eb = W.b[g][0] * eh[6 + 2 * ig] + W.b[g][1] * eh[7 + 2 * ig];
+      const double ec = (W.c[g][0] * eh[12] + W.c[g][1] * eh[13]) + (W.c[g][2] * eh[14] + W.c[g][3] * eh[15]);
+      const Eigen::Matrix3d& T = Tm_[static_cast<size_t>(g)];
+      e.segment<3>(3 * g) = T.col(0) * ea + T.col(1) * eb + T.col(2) * ec;
+    }
+  return e;
+}
+
+void CR9Shell::tying_force(const Eigen::Matrix<double, 27, 1>& s, const TauT& taubar, Vec45* fL) const {
+  // Σ_gp dA B_mᵀ N = Σ_k μ_k ∂ê_k/∂t at t̄ (§4.4), μ = (∂ε/∂ê)ᵀ s: per Gauss point r = Tmᵀ s_gp, spread onto the
+  // tying points with the interpolation weights of tying_strains(). ∂ê_ab/∂t_i = ½[N_i,b (X_a + τ̄_a) +
+  // N_i,a (X_b + τ̄_b)], so f_tᵀ = D_τ G with G's row j the weight of τ point j.
+  const GaussTyingWeights& W = mitc9_gauss_weights();
+  double mu[16] = {};
+  for (int ig = 0; ig < 3; ++ig)
+    for (int jg = 0; jg < 3; ++jg) {
+      const int g = 3 * ig + jg;
+      const Eigen::Vector3d r = Tm_[static_cast<size_t>(g)].transpose() * s.segment<3>(3 * g);
+      mu[jg] += W.a[g][0] * r(0);
+      mu[3 + jg] += W.a[g][1] * r(0);
+      mu[6 + 2 * ig] += W.b[g][0] * r(1);
+      mu[7 + 2 * ig] += W.b[g][1] * r(1);
+      for (int k = 0; k < 4; ++k) mu[12 + k] += W.c[g][k] * r(2);
+    }
+  alignas(16) double m20[20];
+  for (int k = 0; k < 12; ++k) m20[k] = mu[k];
+  for (int k = 12; k < 16; ++k) m20[k] = m20[k + 4] = 0.5 * mu[k];
+  // G(j, c) = m_j (X + τ̄)(j', c), j' = j for families A, B and the partner row (j ± 4) for family C.
+  alignas(16) double G[3][20];
+  for (int c = 0; c < 3; ++c) {
+    const double *X = XtT_.col(c).data(), *u = taubar.col(c).data();
+    for (int k = 0; k < 12; ++k) G[c][k] = m20[k] * (X[k] + u[k]);
+    for (int k = 12; k < 16; ++k) G[c][k] = m20[k] * (X[k + 4] + u[k + 4]);
+    for (int k = 16; k < 20; ++k) G[c][k] = m20[k] * (X[k - 4] + u[k - 4]);
+  }
+  // f_tᵀ = D_τ G: per component a 10-long accumulator (row 9 of the padded D_τ is zero) over the 20 τ points.
+  // (Eigen's packet expressions: plain loops here are turned into scalar dot products by GCC.)
+  const Eigen::Matrix<double, 10, 20>& D = tying_dN10();
+  for (int c = 0; c < 3; ++c) {
+    Eigen::Matrix<double, 10, 1> acc = D.col(0) * G[c][0];
+    for (int j = 1; j < 20; ++j) acc.noalias() += D.col(j) * G[c][j];
+    for (int i = 0; i < 9; ++i) (*fL)(5 * i + c) += acc(i);
+  }
 }
 
 Eigen::Matrix<double, 27, 1> CR9Shell::membrane_strains(const Mat39& t) const {
-  if (tying_) {
-    // §4.4 tying-point strains ê_ab = ½(X_a·τ_b + X_b·τ_a + τ_a·τ_b), then ε = A ê (cr9_shell.hpp, tying_).
-    const Eigen::Matrix<double, 3, 20> tau = tying_tau(t);
-    Eigen::Matrix<double, 16, 1> eh;
-    for (int k = 0; k < 12; ++k) eh(k) = Xt_.col(k).dot(tau.col(k)) + 0.5 * tau.col(k).squaredNorm();
-    for (int k = 12; k < 16; ++k)
-      eh(k) = 0.5 * (Xt_.col(k).dot(tau.col(k + 4)) + Xt_.col(k + 4).dot(tau.col(k)) + tau.col(k).dot(tau.col(k + 4)));
-    Eigen::Matrix<double, 27, 1> e = At_.col(0) * eh(0);
-    for (int k = 1; k < 16; ++k) e.noalias() += At_.col(k) * eh(k);
-    return e;
-  }
+  if (tying_) return tying_strains(tying_tau(t));
   // ε_m,c at every Gauss point: L_m,c·t + ½ Σ_ij H_c(i,j) t_i·t_j = L_m,c·t + ½ H_c : (tᵀt)  (§4.5)
   // Packed Gram matrix with the off-diagonal entries doubled: Σ_ij H_ij G_ij = Σ_k Hp_k g_k.
   Eigen::Matrix<double, 45, 1> g;
@@ -463,7 +566,9 @@ double CR9Shell::membrane(const Mat39& t1, const Mat39& t0, double c1, double c0
 double CR9Shell::membrane_force(const Mat39& t1, const Mat39& t0, double c1, double c0, double b1, double b0,
                                 const StepState& n0, Vec45* fL) const {
   const Eigen::Matrix3d hD1 = mat_.thickness * D1_;
-  const Eigen::Matrix<double, 27, 1> e1 = membrane_strains(t1);
+  TauT tau1;
+  if (tying_) tau1 = tying_tau(t1);
+  const Eigen::Matrix<double, 27, 1> e1 = tying_ ? tying_strains(tau1) : membrane_strains(t1);
   // N* = h D1 (c1 ε1 + c0 ε0) per Gauss point (§6.3), weighted by dA: s = dA N*.
   Eigen::Matrix<double, 27, 1> sN;
   double U = 0.0;
@@ -475,19 +580,11 @@ double CR9Shell::membrane_force(const Mat39& t1, const Mat39& t0, double c1, dou
     sN.segment<3>(3 * g) = dA * N;
   }
   if (tying_) {
-    // Σ_gp dA B_mᵀ N = Σ_k μ_k ∂ê_k/∂t at t̄ = b1 t1 + b0 t0, μ = Aᵀ s (§4.4): ∂ê_ab/∂t_i =
-    // ½[N_i,b (X_a + τ̄_a) + N_i,a (X_b + τ̄_b)], so f_t = G D_τᵀ with G's column j the weight of τ point j.
-    Eigen::Matrix<double, 16, 1> mu = AtT_.col(0) * sN(0);
-    for (int k = 1; k < 27; ++k) mu.noalias() += AtT_.col(k) * sN(k);
-    const Eigen::Matrix<double, 3, 20> xb = Xt_ + tying_tau(b1 * t1 + b0 * t0);  // X_a + τ̄_a
-    Eigen::Matrix<double, 3, 20> G;
-    for (int k = 0; k < 12; ++k) G.col(k) = mu(k) * xb.col(k);
-    for (int k = 12; k < 16; ++k) {
-      G.col(k) = (0.5 * mu(k)) * xb.col(k + 4);
-      G.col(k + 4) = (0.5 * mu(k)) * xb.col(k);
-    }
-    const Eigen::Matrix<double, 10, 3> ftT = tying_dN10().lazyProduct(G.transpose());  // f_tᵀ = D_τ Gᵀ (row 9: 0)
-    for (int i = 0; i < 9; ++i) fL->segment<3>(5 * i) += ftT.row(i).transpose();
+    // τ̄ = τ(t̄) = b1 τ(t1) + b0 τ(t0) (τ is linear in t), with τ(t0) from the step state.
+    TauT taubar;
+    if (b0 != 0.0) taubar = b1 * tau1 + b0 * n0.tau;
+    else taubar = b1 * tau1;
+    tying_force(sN, taubar, fL);
     return U;
   }
   // Σ_gp dA B_mᵀ N with B_m,c = L_m,c + (t̄ H_c) rows, t̄ = b1 t1 + b0 t0: Lᵀ s + t̄ Σ_gp,c s_gp,c H_c.
@@ -528,7 +625,9 @@ double CR9Shell::local(const Vec45& u, const Charts& charts, Vec45* uL, Vec45* f
 double CR9Shell::internal(const Vec45& u, const Charts& charts, Vec45* F, Mat45* K) const {
   Vec45 w;
   const CorotationalFrame fr = local_increments(u, charts, &w, true, K != nullptr);
-  Vec45 fL = Kbs_ * w;
+  // K_bs w: the dense product with K (the tangent's own path) and for an element without zero rows of K_bs (where
+  // it takes fewer instructions than the packed one), else the residual's active block.
+  Vec45 fL = (K || kbs_active_.empty()) ? Vec45(Kbs_ * w) : kbs_times(w);
   double U = 0.5 * w.dot(fL);
   const Mat39 t = translations(w);
   if (K) {
@@ -539,7 +638,7 @@ double CR9Shell::internal(const Vec45& u, const Charts& charts, Vec45* F, Mat45*
     // The force alone: membrane_force() (no B_m matrices formed) with c0 = b0 = 0, so the state of t0 is unused.
     static const StepState unused = [] {
       StepState z;
-      z.w.setZero(), z.Kw.setZero();
+      z.w.setZero(), z.Kw.setZero(), z.tau.setZero();
       for (auto& e : z.e) e.setZero();
       return z;
     }();
@@ -582,7 +681,11 @@ double CR9Shell::algorithmic_internal(const Vec45& u_n, const Vec45& u_np1, cons
 void CR9Shell::step_state(const Vec45& u_n, const Charts& charts, StepState* st) const {
   local_increments(u_n, charts, &st->w, false);
   st->Kw = kbs_times(st->w);
-  const Eigen::Matrix<double, 27, 1> e = membrane_strains(translations(st->w));  // membrane()'s strains, bitwise
+  const Mat39 t = translations(st->w);
+  // membrane()'s and the residual's strains, bitwise: tying_strains(tying_tau(t)) is membrane_strains(t)
+  if (tying_) st->tau = tying_tau(t);
+  else st->tau.setZero();
+  const Eigen::Matrix<double, 27, 1> e = tying_ ? tying_strains(st->tau) : membrane_strains(t);
   for (int g = 0; g < 9; ++g) st->e[static_cast<size_t>(g)] = e.segment<3>(3 * g);
 }
 

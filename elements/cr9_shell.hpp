@@ -77,6 +77,9 @@ class CR9Shell {
     Vec45 w;
     Vec45 Kw;                          // K_bs w_n (bending + shear force at t_n)
     std::array<Eigen::Vector3d, 9> e;  // ε_m at t_n per Gauss point
+    // τ_a of t_n at the 20 τ points of the tying-point membrane form (row = τ point, column = component; zero
+    // without it): the residual's strain gradient at t̄ = b1 t1 + b0 t0 then takes τ̄ = b1 τ(t1) + b0 τ(t_n).
+    Eigen::Matrix<double, 20, 3> tau;
   };
   void step_state(const Vec45& u_n, const Charts& charts, StepState* st) const;
   // The strain energy U(u_n) of a step state, with the expressions of algorithmic_internal()'s residual path (so
@@ -167,16 +170,21 @@ class CR9Shell {
   Vec45 kbs_times(const Vec45& w) const;  // Kbs_ w from Kbsp_ or kbs_block_
   // Tying-point form of the MITC9 membrane strains (§4.4; used when opt_.mitc && opt_.tying_membrane). The
   // covariant membrane strain of tying point k is ê_ab = ½(X_a·τ_b + X_b·τ_a + τ_a·τ_b) with τ_a = Σ_i N_i,a t_i
-  // there, and the Gauss-point Cartesian strains are ε = A ê (A = Tm · MITC9 weights). The 20 "τ points":
-  // columns 0–5 ∂/∂ξ at family A, 6–11 ∂/∂η at family B, 12–15 ∂/∂ξ and 16–19 ∂/∂η at family C (the
-  // shape-function derivatives there are element-independent, tying_dN() in the .cpp). ~1 100 multiplications
-  // per strain evaluation and ~1 600 per force instead of ~2 000 and ~2 200 through L_m, H_m, reading 7.5 kB
-  // of membrane data per residual instead of 15.5 kB (Hp_, Lall_).
+  // there, and the Gauss-point Cartesian strains are ε = Tm ẽ, ẽ the MITC9 interpolation of ê at the Gauss point.
+  // The 20 "τ points": rows 0–5 ∂/∂ξ at family A, 6–11 ∂/∂η at family B, 12–15 ∂/∂ξ and 16–19 ∂/∂η at family C
+  // (the shape-function derivatives there are element-independent, tying_dN() in the .cpp). The interpolation
+  // weights are element-independent too and sparse: family A's η-quadratic and family B's ξ-quadratic weights
+  // are 1 at the tying row through the Gauss point and 0 at the others (the tying rows are the Gauss rows), so a
+  // Gauss point reads 2 + 2 + 4 of the 16 ê (mitc9_gauss_weights() in the .cpp).
   bool tying_ = false;
-  Eigen::Matrix<double, 3, 20> Xt_;   // X_ξ or X_η (local reference geometry) at the τ points
-  Eigen::Matrix<double, 27, 16> At_;  // row 3g + c: ε_c at Gauss point g from ê
-  Eigen::Matrix<double, 16, 27> AtT_; // its transpose (μ = Aᵀ s as 16-long column updates)
-  Eigen::Matrix<double, 3, 20> tying_tau(const Mat39& t) const;
+  using TauT = Eigen::Matrix<double, 20, 3>;
+  TauT XtT_;                             // X_ξ or X_η (local reference geometry) at the τ points, rows as τ
+  std::array<Eigen::Matrix3d, 9> Tm_;    // per Gauss point: [e_ξξ, e_ηη, 2e_ξη] -> [ε_11, ε_22, 2ε_12]
+  TauT tying_tau(const Mat39& t) const;  // τ of the local translations t
+  // ε (entry 3g + c) and the covariant tying strains from τ.
+  Eigen::Matrix<double, 27, 1> tying_strains(const TauT& tau) const;
+  // f_t += Σ_k μ_k ∂ê_k/∂t at the τ̄ of the strain gradient, μ = (∂ε/∂ê)ᵀ s for s = dA N per Gauss point.
+  void tying_force(const Eigen::Matrix<double, 27, 1>& s, const TauT& taubar, Vec45* fL) const;
   Mat45 Kbs_;                           // constant bending + shear stiffness Σ dA (B_b^T M + B_s^T Q)
   std::array<Eigen::Matrix<double, 5, 45>, 9> Bbs_;  // [B_b; B_s] per Gauss point (output only)
   Eigen::Matrix<double, 9, 9> m_;
