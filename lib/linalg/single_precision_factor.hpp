@@ -15,7 +15,16 @@
 // ncol of them are the block's own columns: the dense triangle L1, the rest the rectangle L2 below it),
 // leading dimension pi[s+1] − pi[s], starting at x[px[s]].
 //
-// The solves are deterministic (fixed summation order, no threads), so results do not depend on --threads.
+// Threads (docs/dependencies.md §5.7): called outside a parallel region with omp_get_max_threads() = P ≥ 2, solve()
+// splits the supernodal elimination tree once (per factor and P) into P groups of independent subtrees of balanced
+// work and a top part (the ancestors: separators and the roots). The forward sweep runs each group on its own thread
+// (a group other than the first accumulates its updates of top-part rows in a private vector, added afterwards in
+// group order), then the top part's forward and backward sweeps run on one thread, then each group's backward sweep
+// on its own thread (it reads only its own and top-part entries: the same arithmetic as the sequential sweep).
+// Only the top-part rows of the forward sweep are summed in another order, so P threads agree with one thread to
+// round-off, and a given P is deterministic (the split depends on the factor's structure, not on timing). With one
+// thread (or inside a parallel region, or when no split saves ≥ 10 % of the estimated time) the sequential sweeps
+// run, bitwise as before.
 // Not thread-safe: solve() uses internal work buffers.
 #pragma once
 
@@ -50,15 +59,33 @@ class SupernodalFactorCopy {
   bool empty() const { return n_ == 0; }
   void clear();
 
-  // x = (P ᵀ L̂ L̂ᵀ P)⁻¹ b. x may alias b.
-  void solve(const double* b, double* x) const;
+  // x = (P ᵀ L̂ L̂ᵀ P)⁻¹ b. x may alias b. threads: 0 = omp_get_max_threads() (see above), 1 = sequential, P ≥ 2 =
+  // the P-group split even on fewer threads (tests compare it with the sequential sweeps).
+  void solve(const double* b, double* x, int threads = 0) const;
+
+  // The split for P groups (empty when none pays): estimated time of the split solve over the sequential one
+  // (work = factor entries touched; 1 = no gain), for benchmarks and tests.
+  double split_estimate(int parts) const;
 
  private:
   struct Block {
     Index col0, ncol, nrow;  // first column, columns, rows (ncol of them in the triangle)
     Index rows, vals;        // offsets into rows_ (of the nrow − ncol rows below the triangle) and values_
   };
+  struct Split {  // one P-group split of the elimination tree (see above)
+    int parts = 0;
+    double estimate = 1.0;                       // max group work + top work, over the total
+    std::vector<std::vector<Index>> ranges;      // per group: [first, last] block ranges (subtrees), ascending
+    std::vector<Index> top;                      // top-part blocks, ascending
+    std::vector<std::vector<double>> y, w;       // per group: private right-hand side (groups ≥ 1), block rows
+  };
+  const Split& split(int parts) const;
+  void forward(const Block& bl, double* y, double* w) const;
+  void backward(const Block& bl, double* y, double* w) const;
+  void solve_split(const Split& sp, const double* b, double* x) const;
+
   Index n_ = 0;
+  mutable Split split_;  // cached for split_.parts
   std::vector<Block> blocks_;
   std::vector<Index> rows_, perm_;
   std::vector<Real> values_;
@@ -70,5 +97,11 @@ using DoublePrecisionFactor = SupernodalFactorCopy<double>;
 
 extern template class SupernodalFactorCopy<float>;
 extern template class SupernodalFactorCopy<double>;
+
+// Factors A (full CSC storage, symmetric positive definite) with CHOLMOD's supernodal LLᵀ as the "cholmod" back-end
+// does (upper triangle, AMD, postordered) and copies the factor into out (lib/linalg/linear_solver.cpp). Returns false
+// if A is not positive definite or a value does not fit Real. For tests and benchmarks of the solves.
+template <typename Real>
+bool copy_cholmod_factor(const CscView& A, SupernodalFactorCopy<Real>& out);
 
 }  // namespace shelldyn
