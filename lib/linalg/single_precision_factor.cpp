@@ -233,16 +233,15 @@ const typename SupernodalFactorCopy<Real>::Split& SupernodalFactorCopy<Real>::sp
 }
 
 template <typename Real>
-double SupernodalFactorCopy<Real>::split_estimate(int parts) const {
-  if (n_ == 0 || parts < 2) return 1.0;
-  return split(parts).estimate;
+double SupernodalFactorCopy<Real>::split_estimate() const {
+  if (n_ == 0) return 1.0;
+  return split(kSplitGroups).estimate;
 }
 
 template <typename Real>
-void SupernodalFactorCopy<Real>::solve(const double* b, double* x, int threads) const {
-  if (threads == 0) threads = omp_in_parallel() ? 1 : omp_get_max_threads();
-  if (threads >= 2) {
-    const Split& sp = split(threads);
+void SupernodalFactorCopy<Real>::solve(const double* b, double* x, bool split_solve) const {
+  if (split_solve) {
+    const Split& sp = split(kSplitGroups);
     if (!sp.ranges.empty()) {
       solve_split(sp, b, x);
       return;
@@ -274,7 +273,8 @@ void SupernodalFactorCopy<Real>::solve_split(const Split& sp, const double* b, d
     else
       for (Index k = c0; k < c1; ++k) to[k] = b[perm_[k]];
   };
-#pragma omp parallel num_threads(parts)
+  const int threads = omp_in_parallel() ? 1 : std::min(parts, omp_get_max_threads());
+#pragma omp parallel num_threads(threads) if (threads > 1)
   {
     const int t = omp_get_thread_num(), nt = omp_get_num_threads();
     for (int g = t; g < parts; g += nt) {  // the forward sweep of group g (g ≥ nt only with fewer threads)

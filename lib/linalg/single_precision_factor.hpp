@@ -15,16 +15,15 @@
 // ncol of them are the block's own columns: the dense triangle L1, the rest the rectangle L2 below it),
 // leading dimension pi[s+1] − pi[s], starting at x[px[s]].
 //
-// Threads (docs/dependencies.md §5.7): called outside a parallel region with omp_get_max_threads() = P ≥ 2, solve()
-// splits the supernodal elimination tree once (per factor and P) into P groups of independent subtrees of balanced
-// work and a top part (the ancestors: separators and the roots). The forward sweep runs each group on its own thread
-// (a group other than the first accumulates its updates of top-part rows in a private vector, added afterwards in
-// group order), then the top part's forward and backward sweeps run on one thread, then each group's backward sweep
-// on its own thread (it reads only its own and top-part entries: the same arithmetic as the sequential sweep).
-// Only the top-part rows of the forward sweep are summed in another order, so P threads agree with one thread to
-// round-off, and a given P is deterministic (the split depends on the factor's structure, not on timing). With one
-// thread (or inside a parallel region, or when no split saves ≥ 10 % of the estimated time) the sequential sweeps
-// run, bitwise as before.
+// Threads (docs/dependencies.md §5.7): solve() splits the supernodal elimination tree once per factor into two groups of
+// independent subtrees of balanced work and a top part (the ancestors: separators and the roots). The forward sweep
+// runs each group on its own thread (the second group accumulates its updates of top-part rows in a private vector,
+// added afterwards), then the top part's forward and backward sweeps run on one thread, then each group's backward
+// sweep on its own thread (it reads only its own and top-part entries). The split depends on the factor's structure
+// only, and the arithmetic does not depend on how many threads run it: one thread (--threads 1, or a call inside a
+// parallel region) runs both groups in turn and gets the same bits as two. Compared with the plain sequential
+// sweeps (solve(b, x, false), used when no split saves ≥ 10 % of the estimated work) only the top-part rows of the
+// forward sweep are summed in another order: the results agree to round-off.
 // Not thread-safe: solve() uses internal work buffers.
 #pragma once
 
@@ -59,13 +58,13 @@ class SupernodalFactorCopy {
   bool empty() const { return n_ == 0; }
   void clear();
 
-  // x = (P ᵀ L̂ L̂ᵀ P)⁻¹ b. x may alias b. threads: 0 = omp_get_max_threads() (see above), 1 = sequential, P ≥ 2 =
-  // the P-group split even on fewer threads (tests compare it with the sequential sweeps).
-  void solve(const double* b, double* x, int threads = 0) const;
+  // x = (P ᵀ L̂ L̂ᵀ P)⁻¹ b. x may alias b. split = false: the plain sequential sweeps (for comparisons).
+  void solve(const double* b, double* x, bool split = true) const;
 
-  // The split for P groups (empty when none pays): estimated time of the split solve over the sequential one
-  // (work = factor entries touched; 1 = no gain), for benchmarks and tests.
-  double split_estimate(int parts) const;
+  // Estimated time of the split solve on two threads over the sequential one (work = factor entries touched;
+  // 1 = no split), for benchmarks and tests.
+  double split_estimate() const;
+  static constexpr int kSplitGroups = 2;
 
  private:
   struct Block {
@@ -85,7 +84,7 @@ class SupernodalFactorCopy {
   void solve_split(const Split& sp, const double* b, double* x) const;
 
   Index n_ = 0;
-  mutable Split split_;  // cached for split_.parts
+  mutable Split split_;  // made at the first solve (parts = kSplitGroups)
   std::vector<Block> blocks_;
   std::vector<Index> rows_, perm_;
   std::vector<Real> values_;
