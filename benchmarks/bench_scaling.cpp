@@ -30,6 +30,8 @@
 #include "lib/linalg/linear_solver.hpp"
 #include "lib/model/problem.hpp"
 
+#include "lib/linalg/openmp_wait_policy.hpp"  // passive OpenMP waiting, as in the apps
+
 #include <cholmod.h>
 #include <omp.h>
 #include <sys/resource.h>

@@ -690,6 +690,55 @@ class MumpsSolver final : public LinearSolver {
 
 }  // namespace
 
+template <typename Real>
+bool copy_cholmod_factor(const CscView& A, SupernodalFactorCopy<Real>& out) {
+  check_csc_pattern(A, "copy_cholmod_factor");
+  limit_blas_threads();
+  cholmod_common cc{};
+  cholmod_l_start(&cc);
+  cc.print = 0;
+  cc.nmethods = 1;
+  cc.method[0].ordering = CHOLMOD_AMD;
+  cc.postorder = 1;
+  cc.supernodal = CHOLMOD_SUPERNODAL;
+  cc.final_ll = 0;
+  cholmod_sparse S{};
+  S.nrow = S.ncol = static_cast<size_t>(A.n);
+  S.nzmax = static_cast<size_t>(A.nnz());
+  S.p = const_cast<Index*>(A.colptr);
+  S.i = const_cast<Index*>(A.rowind);
+  S.x = const_cast<double*>(A.values);
+  S.stype = 1;
+  S.itype = CHOLMOD_LONG;
+  S.xtype = CHOLMOD_REAL;
+  S.dtype = CHOLMOD_DOUBLE;
+  S.sorted = 1;
+  S.packed = 1;
+  cholmod_factor* L = nullptr;
+  bool ok = false;
+  single_threaded([&] {
+    L = cholmod_l_analyze(&S, &cc);
+    ok = L != nullptr && cholmod_l_factorize(&S, L, &cc) && cc.status == CHOLMOD_OK && L->is_super && L->is_ll;
+  });
+  if (ok) {
+    SupernodalArrays a;
+    a.n = static_cast<Index>(L->n);
+    a.nsuper = static_cast<Index>(L->nsuper);
+    a.super = static_cast<const Index*>(L->super);
+    a.pi = static_cast<const Index*>(L->pi);
+    a.px = static_cast<const Index*>(L->px);
+    a.s = static_cast<const Index*>(L->s);
+    a.x = static_cast<const double*>(L->x);
+    a.perm = static_cast<const Index*>(L->Perm);
+    ok = out.assign(a);
+  }
+  if (L) cholmod_l_free_factor(&L, &cc);
+  cholmod_l_finish(&cc);
+  return ok;
+}
+template bool copy_cholmod_factor(const CscView&, SupernodalFactorCopy<float>&);
+template bool copy_cholmod_factor(const CscView&, SupernodalFactorCopy<double>&);
+
 void check_csc_pattern(const CscView& A, const std::string& who) {
   std::ostringstream os;
   os << who << ": invalid CSC pattern: ";

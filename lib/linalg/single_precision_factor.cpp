@@ -1,8 +1,11 @@
 // Triangular solves with a float (or double) copy of a supernodal factor: lib/linalg/single_precision_factor.hpp.
 #include "lib/linalg/single_precision_factor.hpp"
 
+#include <omp.h>
+
 #include <algorithm>
 #include <cmath>
+#include <numeric>
 #include <stdexcept>
 #include <string>
 
@@ -15,6 +18,7 @@ void SupernodalFactorCopy<Real>::clear() {
   rows_.clear();
   perm_.clear();
   values_.clear();
+  split_ = Split{};
 }
 
 template <typename Real>
@@ -77,64 +81,252 @@ inline double dot4(const Real* a, const double* w, Index n) {
 }
 }  // namespace
 
+// Forward sweep of one block, L y = P b: its entries of y are gathered into w (its own ncol columns, then the rows
+// below the triangle, so that column j of the block, rows j..nrow−1 contiguous in the factor, meets w[j..nrow−1]
+// contiguously); columns in pairs: divide by the pivots, then one pass over the rows below that subtracts both
+// columns' updates (half the loads and stores of w), so every entry receives its updates in column order, a pair at
+// a time. (Pairing the backward dot products as well measured slower.)
 template <typename Real>
-void SupernodalFactorCopy<Real>::solve(const double* b, double* x) const {
+void SupernodalFactorCopy<Real>::forward(const Block& bl, double* y, double* w) const {
+  const Index* rows = rows_.data() + bl.rows;
+  const Index below = bl.nrow - bl.ncol;
+  std::copy(y + bl.col0, y + bl.col0 + bl.ncol, w);
+  for (Index i = 0; i < below; ++i) w[bl.ncol + i] = y[rows[i]];
+  const Real* col = values_.data() + bl.vals;
+  Index j = 0;
+  for (; j + 1 < bl.ncol; j += 2, col += 2 * bl.nrow) {  // two columns per pass over the rows below
+    const Real* col1 = col + bl.nrow;
+    const double wj = w[j] / static_cast<double>(col[j]);
+    w[j] = wj;
+    const double wj1 = (w[j + 1] - static_cast<double>(col[j + 1]) * wj) / static_cast<double>(col1[j + 1]);
+    w[j + 1] = wj1;
+    for (Index i = j + 2; i < bl.nrow; ++i)
+      w[i] -= static_cast<double>(col[i]) * wj + static_cast<double>(col1[i]) * wj1;
+  }
+  if (j < bl.ncol) {
+    const double wj = w[j] / static_cast<double>(col[j]);
+    w[j] = wj;
+    for (Index i = j + 1; i < bl.nrow; ++i) w[i] -= static_cast<double>(col[i]) * wj;
+  }
+  std::copy(w, w + bl.ncol, y + bl.col0);
+  for (Index i = 0; i < below; ++i) y[rows[i]] = w[bl.ncol + i];
+}
+
+// Backward sweep of one block, Lᵀ z = y; column j: one dot product with the rows below it.
+template <typename Real>
+void SupernodalFactorCopy<Real>::backward(const Block& bl, double* y, double* w) const {
+  const Index* rows = rows_.data() + bl.rows;
+  std::copy(y + bl.col0, y + bl.col0 + bl.ncol, w);
+  for (Index i = 0, below = bl.nrow - bl.ncol; i < below; ++i) w[bl.ncol + i] = y[rows[i]];
+  for (Index j = bl.ncol - 1; j >= 0; --j) {
+    const Real* col = values_.data() + bl.vals + j * bl.nrow;
+    w[j] = (w[j] - dot4(col + j + 1, w + j + 1, bl.nrow - j - 1)) / static_cast<double>(col[j]);
+  }
+  std::copy(w, w + bl.ncol, y + bl.col0);
+}
+
+// The split of the supernodal elimination tree (parent of a block: the block holding its first row below the
+// triangle). Starting from the roots, the heaviest candidate subtree is moved to the top part and replaced by its
+// children, and the candidates are dealt to the groups heaviest first (to the lightest group); the best estimate
+// (heaviest group + top part) over these steps is kept. Needs CHOLMOD's postorder (a subtree is a contiguous block
+// range); otherwise, or when the best estimate saves < 10 %, the split is empty (parts = 0).
+template <typename Real>
+const typename SupernodalFactorCopy<Real>::Split& SupernodalFactorCopy<Real>::split(int parts) const {
+  if (split_.parts == parts || parts < 2) return split_;
+  Split sp;
+  sp.parts = parts;
+  const Index nb = static_cast<Index>(blocks_.size());
+  std::vector<Index> col_block(static_cast<size_t>(n_)), parent(static_cast<size_t>(nb), -1),
+      first(static_cast<size_t>(nb)), count(static_cast<size_t>(nb), 1);
+  std::vector<double> own(static_cast<size_t>(nb)), work(static_cast<size_t>(nb));
+  std::vector<std::vector<Index>> children(static_cast<size_t>(nb));
+  for (Index k = 0; k < nb; ++k)
+    for (Index c = 0; c < blocks_[k].ncol; ++c) col_block[static_cast<size_t>(blocks_[k].col0 + c)] = k;
+  bool postordered = true;
+  for (Index k = 0; k < nb; ++k) {
+    const Block& bl = blocks_[static_cast<size_t>(k)];
+    own[k] = static_cast<double>(bl.nrow) * static_cast<double>(bl.ncol) + static_cast<double>(bl.nrow);
+    work[k] += own[k];
+    if (bl.nrow > bl.ncol) {
+      Index r = rows_[static_cast<size_t>(bl.rows)];
+      for (Index i = 1; i < bl.nrow - bl.ncol; ++i) r = std::min(r, rows_[static_cast<size_t>(bl.rows + i)]);
+      const Index p = col_block[static_cast<size_t>(r)];
+      if (p <= k) { postordered = false; break; }
+      parent[k] = p;
+      children[p].push_back(k);
+    }
+  }
+  if (postordered) {  // subtree sizes, work and first block, children before parents
+    for (Index k = 0; k < nb; ++k) first[k] = k;
+    for (Index k = 0; k < nb; ++k) {
+      const Index p = parent[k];
+      if (p < 0) continue;
+      work[p] += work[k];
+      count[p] += count[k];
+      first[p] = std::min(first[p], first[k]);
+    }
+    for (Index k = 0; k < nb && postordered; ++k) postordered = count[k] == k - first[k] + 1;
+  }
+  const double total = std::accumulate(own.begin(), own.end(), 0.0);
+  if (!postordered || nb < 2 || total <= 0) {
+    split_ = std::move(sp);
+    split_.parts = parts;
+    return split_;
+  }
+  std::vector<Index> cand;
+  for (Index k = 0; k < nb; ++k)
+    if (parent[k] < 0) cand.push_back(k);
+  double top = 0, best = total;
+  std::vector<Index> best_cand;
+  std::vector<int> best_group;
+  for (Index step = 0; step < nb && top < best; ++step) {
+    std::sort(cand.begin(), cand.end(), [&](Index a, Index b) { return work[a] > work[b] || (work[a] == work[b] && a < b); });
+    std::vector<double> load(static_cast<size_t>(parts), 0.0);
+    std::vector<int> group(cand.size());
+    for (size_t c = 0; c < cand.size(); ++c) {
+      const int g = static_cast<int>(std::min_element(load.begin(), load.end()) - load.begin());
+      group[c] = g;
+      load[static_cast<size_t>(g)] += work[cand[c]];
+    }
+    const double est = top + *std::max_element(load.begin(), load.end());
+    if (est < best) {
+      best = est;
+      best_cand = cand;
+      best_group = group;
+    }
+    const Index h = cand.front();
+    if (children[h].empty()) break;
+    cand.erase(cand.begin());
+    top += own[h];
+    cand.insert(cand.end(), children[h].begin(), children[h].end());
+  }
+  sp.estimate = best / total;
+  if (sp.estimate > 0.9 || best_cand.empty()) {
+    sp.estimate = 1.0;
+    split_ = std::move(sp);
+    return split_;
+  }
+  sp.ranges.assign(static_cast<size_t>(parts), {});
+  std::vector<char> in_group(static_cast<size_t>(nb), 0);
+  std::vector<std::vector<std::pair<Index, Index>>> r(static_cast<size_t>(parts));
+  for (size_t c = 0; c < best_cand.size(); ++c) {
+    const Index k = best_cand[c];
+    r[static_cast<size_t>(best_group[c])].push_back({first[k], k});
+    for (Index q = first[k]; q <= k; ++q) in_group[q] = 1;
+  }
+  for (int g = 0; g < parts; ++g) {
+    std::sort(r[g].begin(), r[g].end());
+    for (const auto& pr : r[g]) {
+      sp.ranges[g].push_back(pr.first);
+      sp.ranges[g].push_back(pr.second);
+    }
+  }
+  for (Index k = 0; k < nb; ++k)
+    if (!in_group[k]) sp.top.push_back(k);
+  Index max_rows = 0;
+  for (const Block& bl : blocks_) max_rows = std::max(max_rows, bl.nrow);
+  sp.y.assign(static_cast<size_t>(parts), std::vector<double>());
+  for (int g = 1; g < parts; ++g) sp.y[g].assign(static_cast<size_t>(n_), 0.0);
+  sp.w.assign(static_cast<size_t>(parts), std::vector<double>(static_cast<size_t>(max_rows), 0.0));
+  split_ = std::move(sp);
+  return split_;
+}
+
+template <typename Real>
+double SupernodalFactorCopy<Real>::split_estimate() const {
+  if (n_ == 0) return 1.0;
+  return split(kSplitGroups).estimate;
+}
+
+template <typename Real>
+void SupernodalFactorCopy<Real>::solve(const double* b, double* x, bool split_solve) const {
+  if (split_solve) {
+    const Split& sp = split(kSplitGroups);
+    if (!sp.ranges.empty()) {
+      solve_split(sp, b, x);
+      return;
+    }
+  }
   double* y = y_.data();
   double* w = w_.data();
   if (perm_.empty())
     std::copy(b, b + n_, y);
   else
     for (Index k = 0; k < n_; ++k) y[k] = b[perm_[k]];
-
-  // A block's entries of y are gathered into w: its own ncol columns, then the rows below the triangle, so that
-  // column j of the block (rows j..nrow−1, contiguous in the factor) meets w[j..nrow−1] contiguously.
-  auto gather = [&](const Block& bl) {
-    std::copy(y + bl.col0, y + bl.col0 + bl.ncol, w);
-    const Index* rows = rows_.data() + bl.rows;
-    for (Index i = 0, below = bl.nrow - bl.ncol; i < below; ++i) w[bl.ncol + i] = y[rows[i]];
-  };
-
-  // Forward, L y = P b, blocks in column order; columns in pairs: divide by the pivots, then one pass over the rows
-  // below that subtracts both columns' updates (half the loads and stores of w), so every entry receives its updates
-  // in column order, a pair at a time. (Pairing the backward dot products as well measured slower.)
-  for (const Block& bl : blocks_) {
-    gather(bl);
-    const Real* col = values_.data() + bl.vals;
-    Index j = 0;
-    for (; j + 1 < bl.ncol; j += 2, col += 2 * bl.nrow) {  // two columns per pass over the rows below
-      const Real* col1 = col + bl.nrow;
-      const double wj = w[j] / static_cast<double>(col[j]);
-      w[j] = wj;
-      const double wj1 = (w[j + 1] - static_cast<double>(col[j + 1]) * wj) / static_cast<double>(col1[j + 1]);
-      w[j + 1] = wj1;
-      for (Index i = j + 2; i < bl.nrow; ++i)
-        w[i] -= static_cast<double>(col[i]) * wj + static_cast<double>(col1[i]) * wj1;
-    }
-    if (j < bl.ncol) {
-      const double wj = w[j] / static_cast<double>(col[j]);
-      w[j] = wj;
-      for (Index i = j + 1; i < bl.nrow; ++i) w[i] -= static_cast<double>(col[i]) * wj;
-    }
-    std::copy(w, w + bl.ncol, y + bl.col0);
-    const Index* rows = rows_.data() + bl.rows;
-    for (Index i = 0, below = bl.nrow - bl.ncol; i < below; ++i) y[rows[i]] = w[bl.ncol + i];
-  }
-
-  // Backward, Lᵀ z = y, blocks in reverse order; column j: one dot product with the rows below it.
-  for (auto it = blocks_.rbegin(); it != blocks_.rend(); ++it) {
-    const Block& bl = *it;
-    gather(bl);
-    for (Index j = bl.ncol - 1; j >= 0; --j) {
-      const Real* col = values_.data() + bl.vals + j * bl.nrow;
-      w[j] = (w[j] - dot4(col + j + 1, w + j + 1, bl.nrow - j - 1)) / static_cast<double>(col[j]);
-    }
-    std::copy(w, w + bl.ncol, y + bl.col0);
-  }
-
+  for (const Block& bl : blocks_) forward(bl, y, w);  // blocks in column order
+  for (auto it = blocks_.rbegin(); it != blocks_.rend(); ++it) backward(*it, y, w);  // reverse order
   if (perm_.empty())
     std::copy(y, y + n_, x);
   else
     for (Index k = 0; k < n_; ++k) x[perm_[k]] = y[k];
+}
+
+template <typename Real>
+void SupernodalFactorCopy<Real>::solve_split(const Split& sp, const double* b, double* x) const {
+  double* y = y_.data();
+  const int parts = sp.parts;
+  auto& ys = const_cast<Split&>(sp).y;
+  auto& ws = const_cast<Split&>(sp).w;
+  auto load = [&](double* to, Index c0, Index c1) {
+    if (perm_.empty())
+      std::copy(b + c0, b + c1, to + c0);
+    else
+      for (Index k = c0; k < c1; ++k) to[k] = b[perm_[k]];
+  };
+  const int threads = omp_in_parallel() ? 1 : std::min(parts, omp_get_max_threads());
+#pragma omp parallel num_threads(threads) if (threads > 1)
+  {
+    const int t = omp_get_thread_num(), nt = omp_get_num_threads();
+    for (int g = t; g < parts; g += nt) {  // the forward sweep of group g (g ≥ nt only with fewer threads)
+      double* yg = g == 0 ? y : ys[static_cast<size_t>(g)].data();
+      double* w = ws[static_cast<size_t>(g)].data();
+      const auto& rg = sp.ranges[static_cast<size_t>(g)];
+      for (size_t q = 0; q < rg.size(); q += 2)
+        load(yg, blocks_[rg[q]].col0, blocks_[rg[q + 1]].col0 + blocks_[rg[q + 1]].ncol);
+      for (Index k : sp.top) {
+        const Block& bl = blocks_[static_cast<size_t>(k)];
+        if (g == 0)
+          load(y, bl.col0, bl.col0 + bl.ncol);
+        else
+          std::fill(yg + bl.col0, yg + bl.col0 + bl.ncol, 0.0);
+      }
+      for (size_t q = 0; q < rg.size(); q += 2)
+        for (Index k = rg[q]; k <= rg[q + 1]; ++k) forward(blocks_[static_cast<size_t>(k)], yg, w);
+      if (g != 0)
+        for (size_t q = 0; q < rg.size(); q += 2) {
+          const Index c0 = blocks_[rg[q]].col0, c1 = blocks_[rg[q + 1]].col0 + blocks_[rg[q + 1]].ncol;
+          std::copy(yg + c0, yg + c1, y + c0);
+        }
+    }
+#pragma omp barrier
+#pragma omp single
+    {  // the top part: the groups' updates of its rows in group order, then its forward and backward sweeps
+      double* w = ws[0].data();
+      for (Index k : sp.top) {
+        const Block& bl = blocks_[static_cast<size_t>(k)];
+        for (int g = 1; g < parts; ++g) {
+          const double* yg = ys[static_cast<size_t>(g)].data();
+          for (Index c = bl.col0; c < bl.col0 + bl.ncol; ++c) y[c] += yg[c];
+        }
+      }
+      for (Index k : sp.top) forward(blocks_[static_cast<size_t>(k)], y, w);
+      for (auto it = sp.top.rbegin(); it != sp.top.rend(); ++it) backward(blocks_[static_cast<size_t>(*it)], y, w);
+    }  // implicit barrier
+    for (int g = t; g < parts; g += nt) {  // the backward sweep of group g
+      double* w = ws[static_cast<size_t>(g)].data();
+      const auto& rg = sp.ranges[static_cast<size_t>(g)];
+      for (size_t q = rg.size(); q >= 2; q -= 2)
+        for (Index k = rg[q - 1]; k >= rg[q - 2]; --k) backward(blocks_[static_cast<size_t>(k)], y, w);
+    }
+#pragma omp barrier
+    if (perm_.empty()) {
+#pragma omp for schedule(static)
+      for (Index k = 0; k < n_; ++k) x[k] = y[k];
+    } else {
+#pragma omp for schedule(static)
+      for (Index k = 0; k < n_; ++k) x[perm_[k]] = y[k];
+    }
+  }
 }
 
 template class SupernodalFactorCopy<float>;

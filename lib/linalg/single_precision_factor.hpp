@@ -15,7 +15,15 @@
 // ncol of them are the block's own columns: the dense triangle L1, the rest the rectangle L2 below it),
 // leading dimension pi[s+1] − pi[s], starting at x[px[s]].
 //
-// The solves are deterministic (fixed summation order, no threads), so results do not depend on --threads.
+// Threads (docs/dependencies.md §5.7): solve() splits the supernodal elimination tree once per factor into two groups of
+// independent subtrees of balanced work and a top part (the ancestors: separators and the roots). The forward sweep
+// runs each group on its own thread (the second group accumulates its updates of top-part rows in a private vector,
+// added afterwards), then the top part's forward and backward sweeps run on one thread, then each group's backward
+// sweep on its own thread (it reads only its own and top-part entries). The split depends on the factor's structure
+// only, and the arithmetic does not depend on how many threads run it: one thread (--threads 1, or a call inside a
+// parallel region) runs both groups in turn and gets the same bits as two. Compared with the plain sequential
+// sweeps (solve(b, x, false), used when no split saves ≥ 10 % of the estimated work) only the top-part rows of the
+// forward sweep are summed in another order: the results agree to round-off.
 // Not thread-safe: solve() uses internal work buffers.
 #pragma once
 
@@ -50,15 +58,33 @@ class SupernodalFactorCopy {
   bool empty() const { return n_ == 0; }
   void clear();
 
-  // x = (P ᵀ L̂ L̂ᵀ P)⁻¹ b. x may alias b.
-  void solve(const double* b, double* x) const;
+  // x = (P ᵀ L̂ L̂ᵀ P)⁻¹ b. x may alias b. split = false: the plain sequential sweeps (for comparisons).
+  void solve(const double* b, double* x, bool split = true) const;
+
+  // Estimated time of the split solve on two threads over the sequential one (work = factor entries touched;
+  // 1 = no split), for benchmarks and tests.
+  double split_estimate() const;
+  static constexpr int kSplitGroups = 2;
 
  private:
   struct Block {
     Index col0, ncol, nrow;  // first column, columns, rows (ncol of them in the triangle)
     Index rows, vals;        // offsets into rows_ (of the nrow − ncol rows below the triangle) and values_
   };
+  struct Split {  // one P-group split of the elimination tree (see above)
+    int parts = 0;
+    double estimate = 1.0;                       // max group work + top work, over the total
+    std::vector<std::vector<Index>> ranges;      // per group: [first, last] block ranges (subtrees), ascending
+    std::vector<Index> top;                      // top-part blocks, ascending
+    std::vector<std::vector<double>> y, w;       // per group: private right-hand side (groups ≥ 1), block rows
+  };
+  const Split& split(int parts) const;
+  void forward(const Block& bl, double* y, double* w) const;
+  void backward(const Block& bl, double* y, double* w) const;
+  void solve_split(const Split& sp, const double* b, double* x) const;
+
   Index n_ = 0;
+  mutable Split split_;  // made at the first solve (parts = kSplitGroups)
   std::vector<Block> blocks_;
   std::vector<Index> rows_, perm_;
   std::vector<Real> values_;
@@ -70,5 +96,11 @@ using DoublePrecisionFactor = SupernodalFactorCopy<double>;
 
 extern template class SupernodalFactorCopy<float>;
 extern template class SupernodalFactorCopy<double>;
+
+// Factors A (full CSC storage, symmetric positive definite) with CHOLMOD's supernodal LLᵀ as the "cholmod" back-end
+// does (upper triangle, AMD, postordered) and copies the factor into out (lib/linalg/linear_solver.cpp). Returns false
+// if A is not positive definite or a value does not fit Real. For tests and benchmarks of the solves.
+template <typename Real>
+bool copy_cholmod_factor(const CscView& A, SupernodalFactorCopy<Real>& out);
 
 }  // namespace shelldyn
