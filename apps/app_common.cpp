@@ -329,7 +329,7 @@ BenchmarkApp::BenchmarkApp(std::string name, std::string case_file, std::string 
   cli_.add_option("--t-end", o_.t_end, "End time (default: the case's time.t_end)");
   cli_.add_option("--output-every", o_.output_every, "Output interval in time units (default: the case's)");
   cli_.add_option("--vtu-every", o_.vtu_every, "Write a VTU every N output times; 0 disables (default: the case's)");
-  cli_.add_option("--threads", o_.threads, "OpenMP threads for element loops (default: all cores)");
+  cli_.add_option("--threads", o_.threads, "OpenMP threads for element loops and triangular solves (default: all cores)");
   cli_.add_flag("-q,--quiet", o_.quiet, "No progress lines");
   cli_.add_flag("--no-plots", o_.no_plots, "Do not call scripts/plot_run.py");
   cli_.add_flag("--overwrite", o_.overwrite, "Replace the results of an earlier run in the result folder");

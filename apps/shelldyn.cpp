@@ -378,7 +378,7 @@ void add_run_command(CLI::App& app, Action& action, const std::string& command) 
   sub->add_option("--t-end", o->t_end, "End time (default: the case's time.t_end)");
   sub->add_option("--output-every", o->output_every, "Output interval in time units (default: the case's time.output_interval)");
   sub->add_option("--vtu-every", o->vtu_every, "Write a VTU every N output times; 0 disables (default: the case's output.vtu_every)");
-  sub->add_option("--threads", o->threads, "OpenMP threads for element loops (default: all cores)");
+  sub->add_option("--threads", o->threads, "OpenMP threads for element loops and triangular solves (default: all cores)");
   sub->add_flag("-q,--quiet", o->quiet, "No progress line and no summary table: one result line (errors still reported)");
   sub->add_flag("--plots", o->plots, "After the run, write energy.png, momentum.png, monitors.png with scripts/plot_run.py (needs python3-matplotlib)");
   sub->add_option("--checkpoint-every", o->checkpoint_every,
@@ -449,7 +449,7 @@ void add_resume_command(CLI::App& app, Action& action, const std::string& comman
   sub->add_option("dir", o->case_path, "Result folder of the run, e.g. results/flying-plate/em-galpha")->required();
   sub->add_option("--max-steps", o->max_steps, "Stop again at the first output time after N steps in total (default: as before)");
   sub->add_option("--max-wall", o->max_wall, "Stop again after S seconds of wall time in total (default: as before)");
-  sub->add_option("--threads", o->threads, "OpenMP threads for element loops (default: all cores)");
+  sub->add_option("--threads", o->threads, "OpenMP threads for element loops and triangular solves (default: all cores)");
   sub->add_flag("-q,--quiet", o->quiet, "No progress lines");
   add_plugin_option(sub, o->plugins);
   sub->add_flag("--allow-changed-case", o->allow_changed_case,
