@@ -16,9 +16,10 @@ import os
 import shutil
 import tempfile
 
-# Passive OpenMP waiting, as the shelldyn executables set it (lib/linalg/openmp_wait_policy.hpp): libgomp reads the
-# variable when it is loaded with the extension below; a value set by the user is kept.
-os.environ.setdefault("OMP_WAIT_POLICY", "passive")
+# Bounded spinning of idle OpenMP threads, as the shelldyn executables set it (lib/linalg/openmp_wait_policy.hpp):
+# libgomp reads the variables when it is loaded with the extension below; values set by the user are kept.
+if "OMP_WAIT_POLICY" not in os.environ:
+    os.environ.setdefault("GOMP_SPINCOUNT", "10000")
 
 from ._shelldyn import (  # noqa: F401  (re-exported)
     DOFS_PER_NODE,
