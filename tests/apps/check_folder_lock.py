@@ -49,7 +49,7 @@ def main():
     if os.path.isdir(work):
         shutil.rmtree(work)
     os.makedirs(work)
-    args = [case, "--dt", "0.01", "--t-end", "0.6", "--output-every", "0.01", "--vtu-every", "10", "--threads", "1", "-q"]
+    args = [case, "--dt", "0.01", "--t-end", "2.0", "--output-every", "0.02", "--vtu-every", "10", "--threads", "1", "-q"]
     ref = os.path.join(work, "ref")
     r = subprocess.run([exe, "run"] + args + ["-o", ref], capture_output=True, text=True, timeout=600)
     if r.returncode != 0:
