@@ -95,6 +95,22 @@ std::string blas_description() {
 }
 
 namespace {
+// A CHOLMOD view of A's upper triangle (stype = +1: entries below the diagonal are ignored).
+cholmod_sparse header(const CscView& A) {
+  cholmod_sparse S{};
+  S.nrow = S.ncol = static_cast<size_t>(A.n);
+  S.nzmax = static_cast<size_t>(A.nnz());
+  S.p = const_cast<Index*>(A.colptr);  // CHOLMOD never writes its input matrix
+  S.i = const_cast<Index*>(A.rowind);
+  S.x = const_cast<double*>(A.values);
+  S.stype = 1;
+  S.itype = CHOLMOD_LONG;
+  S.xtype = CHOLMOD_REAL;
+  S.dtype = CHOLMOD_DOUBLE;
+  S.sorted = 1;
+  S.packed = 1;
+  return S;
+}
 
 template <class F>
 void single_threaded(const F& f) {
@@ -252,22 +268,6 @@ class CholmodSolver final : public LinearSolver {
   }
 
  private:
-  // Upper triangle of the full storage (stype = +1): entries below the diagonal are ignored.
-  cholmod_sparse header(const CscView& A) const {
-    cholmod_sparse S{};
-    S.nrow = S.ncol = static_cast<size_t>(A.n);
-    S.nzmax = static_cast<size_t>(A.nnz());
-    S.p = const_cast<Index*>(A.colptr);  // CHOLMOD never writes its input matrix
-    S.i = const_cast<Index*>(A.rowind);
-    S.x = const_cast<double*>(A.values);
-    S.stype = 1;
-    S.itype = CHOLMOD_LONG;
-    S.xtype = CHOLMOD_REAL;
-    S.dtype = CHOLMOD_DOUBLE;
-    S.sorted = 1;
-    S.packed = 1;
-    return S;
-  }
   Index original_column(size_t minor) const {
     if (L_ && L_->Perm && minor < L_->n) return static_cast<const Index*>(L_->Perm)[minor];
     return static_cast<Index>(minor);
@@ -702,18 +702,7 @@ bool copy_cholmod_factor(const CscView& A, SupernodalFactorCopy<Real>& out) {
   cc.postorder = 1;
   cc.supernodal = CHOLMOD_SUPERNODAL;
   cc.final_ll = 0;
-  cholmod_sparse S{};
-  S.nrow = S.ncol = static_cast<size_t>(A.n);
-  S.nzmax = static_cast<size_t>(A.nnz());
-  S.p = const_cast<Index*>(A.colptr);
-  S.i = const_cast<Index*>(A.rowind);
-  S.x = const_cast<double*>(A.values);
-  S.stype = 1;
-  S.itype = CHOLMOD_LONG;
-  S.xtype = CHOLMOD_REAL;
-  S.dtype = CHOLMOD_DOUBLE;
-  S.sorted = 1;
-  S.packed = 1;
+  cholmod_sparse S = header(A);
   cholmod_factor* L = nullptr;
   bool ok = false;
   single_threaded([&] {
