@@ -7,6 +7,8 @@
 #include "lib/linalg/single_precision_factor.hpp"
 #include "lib/model/problem.hpp"
 
+#include "tests/support/shell_matrices.hpp"
+
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
@@ -22,47 +24,8 @@
 namespace shelldyn {
 namespace {
 
-// ne × ne mesh of 9-node elements, 5 DOFs per node, per element a random SPD block B Bᵀ/45 + 0.01 I.
-SparseMatrix shell_matrix(int ne, unsigned seed) {
-  const int nn = 2 * ne + 1;
-  const Index n = Index(nn) * nn * 5;
-  std::mt19937 rng(seed);
-  std::normal_distribution<double> normal;
-  std::vector<Eigen::Triplet<double, Index>> trip;
-  for (int ey = 0; ey < ne; ++ey)
-    for (int ex = 0; ex < ne; ++ex) {
-      std::vector<Index> dofs;
-      for (int a = 0; a < 3; ++a)
-        for (int b = 0; b < 3; ++b)
-          for (int c = 0; c < 5; ++c) dofs.push_back((Index(2 * ey + a) * nn + (2 * ex + b)) * 5 + c);
-      Eigen::MatrixXd B(45, 45);
-      for (int i = 0; i < 45; ++i)
-        for (int j = 0; j < 45; ++j) B(i, j) = normal(rng);
-      const Eigen::MatrixXd Ke = B * B.transpose() / 45.0 + 0.01 * Eigen::MatrixXd::Identity(45, 45);
-      for (int i = 0; i < 45; ++i)
-        for (int j = 0; j < 45; ++j) trip.emplace_back(dofs[i], dofs[j], Ke(i, j));
-    }
-  Eigen::SparseMatrix<double, Eigen::ColMajor, Index> A(n, n);
-  A.setFromTriplets(trip.begin(), trip.end());
-  A.makeCompressed();
-  auto pattern = std::make_shared<SparsePattern>();
-  pattern->n = n;
-  pattern->colptr.assign(A.outerIndexPtr(), A.outerIndexPtr() + n + 1);
-  pattern->rowind.assign(A.innerIndexPtr(), A.innerIndexPtr() + A.nonZeros());
-  SparseMatrix M;
-  M.pattern = pattern;
-  M.values.assign(A.valuePtr(), A.valuePtr() + A.nonZeros());
-  return M;
-}
-
-double relative_residual(const CscView& A, const std::vector<double>& x, const std::vector<double>& b) {
-  std::vector<double> r(b.begin(), b.end());
-  for (Index j = 0; j < A.n; ++j)
-    for (Index p = A.colptr[j]; p < A.colptr[j + 1]; ++p) r[A.rowind[p]] -= A.values[p] * x[j];
-  double rr = 0, bb = 0;
-  for (size_t i = 0; i < b.size(); ++i) rr += r[i] * r[i], bb += b[i] * b[i];
-  return std::sqrt(rr / bb);
-}
+using test::relative_residual;
+using test::shell_like_matrix;
 
 double max_relative_difference(const std::vector<double>& x, const std::vector<double>& y) {
   double d = 0, m = 0;
@@ -72,7 +35,7 @@ double max_relative_difference(const std::vector<double>& x, const std::vector<d
 
 template <typename Real>
 void check_split(int ne, double residual_bound) {
-  const SparseMatrix A = shell_matrix(ne, 70 + ne);
+  const SparseMatrix A = shell_like_matrix(ne, 70 + ne);
   SupernodalFactorCopy<Real> f;
   ASSERT_TRUE(copy_cholmod_factor(A.view(), f));
   const double estimate = f.split_estimate();
@@ -111,7 +74,7 @@ TEST(ParallelSolve, SplitSolveAgreesWithSequentialFloat) { check_split<float>(24
 
 // Through the "cholmod" back-end (solve_precision = double): two threads give the bits of one thread.
 TEST(ParallelSolve, CholmodBackEndTwoThreadsAgreeWithOne) {
-  const SparseMatrix A = shell_matrix(30, 5);
+  const SparseMatrix A = shell_like_matrix(30, 5);
   auto s = make_linear_solver("cholmod");
   s->factorize(A.view());
   std::vector<double> b(static_cast<size_t>(A.pattern->n));
