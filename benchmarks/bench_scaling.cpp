@@ -30,7 +30,7 @@
 #include "lib/linalg/linear_solver.hpp"
 #include "lib/model/problem.hpp"
 
-#include "lib/linalg/openmp_wait_policy.hpp"  // passive OpenMP waiting, as in the apps
+#include "lib/linalg/openmp_wait_policy.hpp"  // OpenMP threads wait as in the apps (bounded spin)
 
 #include <cholmod.h>
 #include <omp.h>

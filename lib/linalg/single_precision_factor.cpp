@@ -81,17 +81,23 @@ inline double dot4(const Real* a, const double* w, Index n) {
 }
 }  // namespace
 
-// Forward sweep of one block, L y = P b: its entries of y are gathered into w (its own ncol columns, then the rows
-// below the triangle, so that column j of the block, rows j..nrow−1 contiguous in the factor, meets w[j..nrow−1]
-// contiguously); columns in pairs: divide by the pivots, then one pass over the rows below that subtracts both
-// columns' updates (half the loads and stores of w), so every entry receives its updates in column order, a pair at
-// a time. (Pairing the backward dot products as well measured slower.)
+// A block's entries of y gathered into w: its own ncol columns, then the rows below the triangle, so that column j
+// of the block (rows j..nrow−1, contiguous in the factor) meets w[j..nrow−1] contiguously.
+template <typename Real>
+void SupernodalFactorCopy<Real>::gather(const Block& bl, const double* y, double* w) const {
+  const Index* rows = rows_.data() + bl.rows;
+  std::copy(y + bl.col0, y + bl.col0 + bl.ncol, w);
+  for (Index i = 0, below = bl.nrow - bl.ncol; i < below; ++i) w[bl.ncol + i] = y[rows[i]];
+}
+
+// Forward sweep of one block, L y = P b: columns in pairs: divide by the pivots, then one pass over the rows below
+// that subtracts both columns' updates (half the loads and stores of w), so every entry receives its updates in
+// column order, a pair at a time. (Pairing the backward dot products as well measured slower.)
 template <typename Real>
 void SupernodalFactorCopy<Real>::forward(const Block& bl, double* y, double* w) const {
   const Index* rows = rows_.data() + bl.rows;
   const Index below = bl.nrow - bl.ncol;
-  std::copy(y + bl.col0, y + bl.col0 + bl.ncol, w);
-  for (Index i = 0; i < below; ++i) w[bl.ncol + i] = y[rows[i]];
+  gather(bl, y, w);
   const Real* col = values_.data() + bl.vals;
   Index j = 0;
   for (; j + 1 < bl.ncol; j += 2, col += 2 * bl.nrow) {  // two columns per pass over the rows below
@@ -115,9 +121,7 @@ void SupernodalFactorCopy<Real>::forward(const Block& bl, double* y, double* w) 
 // Backward sweep of one block, Lᵀ z = y; column j: one dot product with the rows below it.
 template <typename Real>
 void SupernodalFactorCopy<Real>::backward(const Block& bl, double* y, double* w) const {
-  const Index* rows = rows_.data() + bl.rows;
-  std::copy(y + bl.col0, y + bl.col0 + bl.ncol, w);
-  for (Index i = 0, below = bl.nrow - bl.ncol; i < below; ++i) w[bl.ncol + i] = y[rows[i]];
+  gather(bl, y, w);
   for (Index j = bl.ncol - 1; j >= 0; --j) {
     const Real* col = values_.data() + bl.vals + j * bl.nrow;
     w[j] = (w[j] - dot4(col + j + 1, w + j + 1, bl.nrow - j - 1)) / static_cast<double>(col[j]);
@@ -170,7 +174,6 @@ const typename SupernodalFactorCopy<Real>::Split& SupernodalFactorCopy<Real>::sp
   const double total = std::accumulate(own.begin(), own.end(), 0.0);
   if (!postordered || nb < 2 || total <= 0) {
     split_ = std::move(sp);
-    split_.parts = parts;
     return split_;
   }
   std::vector<Index> cand;

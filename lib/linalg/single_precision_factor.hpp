@@ -79,6 +79,7 @@ class SupernodalFactorCopy {
     std::vector<std::vector<double>> y, w;       // per group: private right-hand side (groups ≥ 1), block rows
   };
   const Split& split(int parts) const;
+  void gather(const Block& bl, const double* y, double* w) const;
   void forward(const Block& bl, double* y, double* w) const;
   void backward(const Block& bl, double* y, double* w) const;
   void solve_split(const Split& sp, const double* b, double* x) const;
