@@ -406,8 +406,11 @@ RunSummary run_dynamic(Problem& problem, const RunOptions& o) {
       if (!resume) bodies_csv = std::make_unique<AppendFile>(path, body_state_header());
       else if (resume->numbers.count("bodies_bytes"))
         bodies_csv = std::make_unique<AppendFile>(path, body_state_header(), static_cast<long long>(resume->number("bodies_bytes")));
-      else
-        bodies_csv = std::make_unique<AppendFile>(path, body_state_header(), static_cast<long long>(std::filesystem::file_size(path)));
+      else {
+        std::error_code ec;  // (a missing file: AppendFile says so)
+        const auto size = std::filesystem::file_size(path, ec);
+        bodies_csv = std::make_unique<AppendFile>(path, body_state_header(), ec ? 0LL : static_cast<long long>(size));
+      }
     }
   }
 

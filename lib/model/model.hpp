@@ -120,9 +120,10 @@ class Model final : public ExactEnergySystem {
   // Throws std::invalid_argument (one line naming the body or joint) on bad definitions.
   void set_multibody(std::vector<RigidBodyDef> bodies, std::vector<JointDef> joints, const Vec3& gravity);
   // Setup checks at the initial state s (ModelMultibody::check_initial): the joints are not redundant, do not act
-  // on supported DOFs, and hold at s (positions and velocities). No-op without joints.
-  void check_constraints(const State& s) const {
-    if (mb_) mb_->check_initial(s.u, s.v, s.charts, dofs_);
+  // on supported DOFs, and hold at s (positions and velocities); `advice` replaces the generic advice of a violated
+  // joint. No-op without joints.
+  void check_constraints(const State& s, const std::string& advice = {}) const {
+    if (mb_) mb_->check_initial(s.u, s.v, s.charts, dofs_, 1e-8, advice);
   }
   const ModelMultibody* multibody() const { return mb_.get(); }
   int num_rigid_bodies() const override { return mb_ ? mb_->num_bodies() : 0; }

@@ -407,7 +407,8 @@ void ModelMultibody::discrete_tangent(double t0, const Eigen::VectorXd& u0, doub
 }
 
 void ModelMultibody::check_initial(const Eigen::VectorXd& u0, const Eigen::VectorXd& v0,
-                                   const std::vector<DirectorChart>& charts, const DofMap& dofs, double tol) const {
+                                   const std::vector<DirectorChart>& charts, const DofMap& dofs, double tol,
+                                   const std::string& advice) const {
   if (set_.rows() == 0) return;
   const Eigen::VectorXd y = to_y(u0, charts);
   // Constraint name → user-facing joint (or body) name and type.
@@ -476,7 +477,8 @@ void ModelMultibody::check_initial(const Eigen::VectorXd& u0, const Eigen::Vecto
     const double e = g.segment(b.first_row, b.rows).cwiseAbs().maxCoeff();
     if (e > tol * scale)
       throw std::invalid_argument(b.type + " '" + b.name + "' is violated by " + num(e) +
-                                  " at t = 0: put its ends together (`at`, body position, axes)");
+                                  (advice.empty() ? " at t = 0: put its ends together (`at`, body position, axes)"
+                                                  : ": " + advice));
   }
   ConstraintMatrix G;
   jacobian(0.0, u0, charts, dofs, G);
@@ -489,7 +491,7 @@ void ModelMultibody::check_initial(const Eigen::VectorXd& u0, const Eigen::Vecto
     const double e = gdot.segment(b.first_row, b.rows).cwiseAbs().maxCoeff();
     if (e > tol * scale * vscale)
       throw std::invalid_argument(b.type + " '" + b.name + "': initial velocities violate it by " + num(e) +
-                                  " (|G v + dg/dt|): make them consistent with the joint");
+                                  (advice.empty() ? " (|G v + dg/dt|): make them consistent with the joint" : ": " + advice));
   }
 }
 

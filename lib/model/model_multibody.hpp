@@ -108,9 +108,10 @@ class ModelMultibody {
 
   // Setup checks (docs/manual.md "Rigid bodies and joints"): full row rank of G at the initial state (redundant
   // or conflicting joints named), no joint on DOFs a support fixes, and the initial state satisfying the joints
-  // (positions and velocities) to `tol`. Throws std::invalid_argument with one line.
+  // (positions and velocities) to `tol`. Throws std::invalid_argument with one line. `advice`, if not empty, replaces
+  // the generic advice of a violated joint (e.g. why the caller's initial state breaks it).
   void check_initial(const Eigen::VectorXd& u0, const Eigen::VectorXd& v0, const std::vector<DirectorChart>& charts,
-                     const DofMap& dofs, double tol = 1e-8) const;
+                     const DofMap& dofs, double tol = 1e-8, const std::string& advice = {}) const;
 
  private:
   Eigen::VectorXd to_y(const Eigen::VectorXd& u, const std::vector<DirectorChart>& charts) const;
